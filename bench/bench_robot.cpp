@@ -1,0 +1,222 @@
+// Micro-benchmarks of the robot model (issue 2): kinematics, dynamics and collision checking of
+// the bundled Panda. Every benchmark cycles through a fixed, seeded pool of random states within
+// the joint limits, so the timings are not of one memorised input. Single-threaded.
+//
+//   ./build/bin/bench_robot --benchmark_min_time=0.2
+#include <benchmark/benchmark.h>
+
+#include <cstddef>
+#include <random>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "collision/collision_model.h"
+#include "collision/environment.h"
+#include "robot/dynamics.h"
+#include "robot/kinematics.h"
+#include "robot/robot_model.h"
+
+namespace {
+
+using namespace lazyboe;
+
+constexpr std::size_t kPoolSize = 1024;  // power of two: the index wraps with a mask
+constexpr std::size_t kPoolMask = kPoolSize - 1;
+constexpr std::uint64_t kSeed = 20240502;
+
+const RobotModel& robot() {
+  static const RobotModel model = load_robot(default_robot_path());
+  return model;
+}
+
+// Uniform in [lo, hi] per joint.
+JointVector uniform(std::mt19937_64& rng, const JointVector& lo, const JointVector& hi) {
+  JointVector v(lo.size());
+  for (int i = 0; i < lo.size(); ++i) v[i] = std::uniform_real_distribution<double>(lo[i], hi[i])(rng);
+  return v;
+}
+
+struct StatePool {
+  std::vector<JointVector> q, dq, ddq, tau;
+};
+
+// q in [q_min, q_max], dq in +-dq_max, ddq in +-ddq_max, tau in +-tau_max.
+const StatePool& state_pool() {
+  static const StatePool pool = [] {
+    const RobotModel& m = robot();
+    std::mt19937_64 rng(kSeed);
+    StatePool p;
+    for (std::size_t k = 0; k < kPoolSize; ++k) {
+      p.q.push_back(uniform(rng, m.q_min, m.q_max));
+      p.dq.push_back(uniform(rng, -m.dq_max, m.dq_max));
+      p.ddq.push_back(uniform(rng, -m.ddq_max, m.ddq_max));
+      p.tau.push_back(uniform(rng, -m.tau_max, m.tau_max));
+    }
+    return p;
+  }();
+  return pool;
+}
+
+// A collision scene: the robot against one bundled environment, plus configuration pools.
+struct Scene {
+  CollisionModel model;
+  std::vector<JointVector> free_q;    // collision-free configurations only
+  std::vector<JointVector> random_q;  // unfiltered
+  double random_collision_fraction = 0;
+  double free_acceptance = 0;         // fraction of random draws that were collision-free
+};
+
+bool check(const CollisionModel& model, RobotData& rd, CollisionData& cd, const JointVector& q) {
+  forward_kinematics(robot(), rd, q);
+  update_collision_transforms(model, cd, rd);
+  return in_collision(model, cd);
+}
+
+Scene make_scene(const std::string& environment_file, std::uint64_t seed) {
+  const RobotModel& m = robot();
+  Scene s{build_collision_model(m, load_environment(data_dir() + "/environments/" + environment_file)),
+          {}, {}, 0, 0};
+  RobotData rd(m);
+  CollisionData cd(s.model);
+  std::mt19937_64 rng(seed);
+  int colliding = 0;
+  for (std::size_t k = 0; k < kPoolSize; ++k) {
+    s.random_q.push_back(uniform(rng, m.q_min, m.q_max));
+    colliding += check(s.model, rd, cd, s.random_q.back());
+  }
+  s.random_collision_fraction = static_cast<double>(colliding) / kPoolSize;
+  std::size_t draws = 0;
+  while (s.free_q.size() < kPoolSize) {
+    if (++draws > 1000 * kPoolSize) throw std::runtime_error("no collision-free configurations");
+    JointVector q = uniform(rng, m.q_min, m.q_max);
+    if (!check(s.model, rd, cd, q)) s.free_q.push_back(q);
+  }
+  s.free_acceptance = static_cast<double>(kPoolSize) / draws;
+  return s;
+}
+
+const Scene& table_scene() {
+  static const Scene scene = make_scene("table.json", kSeed + 1);
+  return scene;
+}
+const Scene& shelf_scene() {
+  static const Scene scene = make_scene("shelf.json", kSeed + 2);
+  return scene;
+}
+
+// ---- Kinematics and dynamics ------------------------------------------------------------------
+
+void BM_ForwardKinematics(benchmark::State& state) {
+  const RobotModel& m = robot();
+  const StatePool& p = state_pool();
+  RobotData data(m);
+  std::size_t k = 0;
+  for (auto _ : state) {
+    forward_kinematics(m, data, p.q[k]);
+    benchmark::DoNotOptimize(data.body_pose.back());
+    k = (k + 1) & kPoolMask;
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_ForwardKinematics);
+
+void BM_InverseDynamics(benchmark::State& state) {
+  const RobotModel& m = robot();
+  const StatePool& p = state_pool();
+  RobotData data(m);
+  std::size_t k = 0;
+  for (auto _ : state) {
+    const JointVector& tau = inverse_dynamics(m, data, p.q[k], p.dq[k], p.ddq[k]);
+    benchmark::DoNotOptimize(tau);
+    k = (k + 1) & kPoolMask;
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_InverseDynamics);
+
+void BM_MassMatrix(benchmark::State& state) {
+  const RobotModel& m = robot();
+  const StatePool& p = state_pool();
+  RobotData data(m);
+  std::size_t k = 0;
+  for (auto _ : state) {
+    const JointMatrix& M = mass_matrix(m, data, p.q[k]);
+    benchmark::DoNotOptimize(M);
+    k = (k + 1) & kPoolMask;
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_MassMatrix);
+
+void BM_ForwardDynamics(benchmark::State& state) {
+  const RobotModel& m = robot();
+  const StatePool& p = state_pool();
+  RobotData data(m);
+  std::size_t k = 0;
+  for (auto _ : state) {
+    const JointVector& ddq = forward_dynamics(m, data, p.q[k], p.dq[k], p.tau[k]);
+    benchmark::DoNotOptimize(ddq);
+    k = (k + 1) & kPoolMask;
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_ForwardDynamics);
+
+// ---- Collision: forward kinematics + transform update + self and environment check -----------
+
+// noinline: lets a profiler (callgrind --toggle-collect) isolate the timed loop from pool setup.
+[[gnu::noinline]] void run_collision_check(benchmark::State& state, const Scene& scene,
+                         const std::vector<JointVector>& pool) {
+  const RobotModel& m = robot();
+  RobotData rd(m);
+  CollisionData cd(scene.model);
+  std::size_t k = 0, hits = 0;
+  for (auto _ : state) {
+    forward_kinematics(m, rd, pool[k]);
+    update_collision_transforms(scene.model, cd, rd);
+    const bool hit = in_collision(scene.model, cd);
+    benchmark::DoNotOptimize(hit);
+    hits += hit;
+    k = (k + 1) & kPoolMask;
+  }
+  state.SetItemsProcessed(state.iterations());
+  state.counters["colliding"] = static_cast<double>(hits) / static_cast<double>(state.iterations());
+  state.counters["self_pairs"] = static_cast<double>(scene.model.self_pairs.size());
+  state.counters["env_pairs"] = static_cast<double>(scene.model.env_pairs.size());
+}
+
+void BM_CollisionCheck_Table_CollisionFree(benchmark::State& state) {
+  run_collision_check(state, table_scene(), table_scene().free_q);
+}
+BENCHMARK(BM_CollisionCheck_Table_CollisionFree);
+
+void BM_CollisionCheck_Table_Unfiltered(benchmark::State& state) {
+  run_collision_check(state, table_scene(), table_scene().random_q);
+}
+BENCHMARK(BM_CollisionCheck_Table_Unfiltered);
+
+void BM_CollisionCheck_Shelf_CollisionFree(benchmark::State& state) {
+  run_collision_check(state, shelf_scene(), shelf_scene().free_q);
+}
+BENCHMARK(BM_CollisionCheck_Shelf_CollisionFree);
+
+// The exact-distance path: FCL distance on every tested pair, no culling. For reference only.
+void BM_MinDistance_Table(benchmark::State& state) {
+  const RobotModel& m = robot();
+  const Scene& scene = table_scene();
+  RobotData rd(m);
+  CollisionData cd(scene.model);
+  std::size_t k = 0;
+  for (auto _ : state) {
+    forward_kinematics(m, rd, scene.free_q[k]);
+    update_collision_transforms(scene.model, cd, rd);
+    const DistanceReport d = min_distance(scene.model, cd);
+    benchmark::DoNotOptimize(d);
+    k = (k + 1) & kPoolMask;
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_MinDistance_Table);
+
+}  // namespace

@@ -1,0 +1,228 @@
+#include "collision/collision_model.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "common/error.h"
+
+namespace lazyboe {
+namespace {
+
+std::shared_ptr<fcl::CollisionGeometryd> make_geometry(const Shape& s, double inflate) {
+  switch (s.type) {
+    case ShapeType::Sphere:
+      return std::make_shared<fcl::Sphered>(s.radius + inflate);
+    case ShapeType::Capsule:
+      return std::make_shared<fcl::Capsuled>(s.radius + inflate, s.length);
+    case ShapeType::Cylinder:
+      return std::make_shared<fcl::Cylinderd>(s.radius + inflate, s.length + 2 * inflate);
+    case ShapeType::Box:
+      return std::make_shared<fcl::Boxd>(s.size + Eigen::Vector3d::Constant(2 * inflate));
+  }
+  return nullptr;
+}
+
+double bounding_radius(const Shape& s) {
+  switch (s.type) {
+    case ShapeType::Sphere: return s.radius;
+    case ShapeType::Capsule: return s.radius + s.length / 2;
+    case ShapeType::Cylinder: return std::hypot(s.radius, s.length / 2);
+    case ShapeType::Box: return s.size.norm() / 2;
+  }
+  return 0;
+}
+
+Eigen::Vector3d bounding_half_extents(const Shape& s) {
+  switch (s.type) {
+    case ShapeType::Sphere: return Eigen::Vector3d::Constant(s.radius);
+    case ShapeType::Capsule: return Eigen::Vector3d(s.radius, s.radius, s.radius + s.length / 2);
+    case ShapeType::Cylinder: return Eigen::Vector3d(s.radius, s.radius, s.length / 2);
+    case ShapeType::Box: return s.size / 2;
+  }
+  return Eigen::Vector3d::Zero();
+}
+
+fcl::Transform3d to_fcl(const Pose& pose) {
+  fcl::Transform3d t = fcl::Transform3d::Identity();
+  t.linear() = pose.R;
+  t.translation() = pose.p;
+  return t;
+}
+
+// Can a robot shape's bounding sphere (grown by `grow`) touch an obstacle's bounding box?
+bool sphere_may_touch_box(const Eigen::Vector3d& centre, double radius,
+                          const CollisionModel::ObstacleShape& o) {
+  const Eigen::Vector3d local = o.pose.R.transpose() * (centre - o.pose.p);
+  const Eigen::Vector3d outside =
+      (local.cwiseAbs() - o.half_extents).cwiseMax(Eigen::Vector3d::Zero());
+  return outside.squaredNorm() <= radius * radius;
+}
+
+bool spheres_may_touch(const CollisionData& data, const CollisionModel& model, int a, int b,
+                       double grow) {
+  const double r = model.robot[a].sphere_radius + model.robot[b].sphere_radius + grow;
+  return (data.sphere_centre[a] - data.sphere_centre[b]).squaredNorm() <= r * r;
+}
+
+bool narrow_collide(CollisionData& data, const fcl::CollisionGeometryd* g1,
+                    const fcl::Transform3d& t1, const fcl::CollisionGeometryd* g2,
+                    const fcl::Transform3d& t2) {
+  data.result.clear();
+  return fcl::collide(g1, t1, g2, t2, data.request, data.result) > 0;
+}
+
+double narrow_distance(CollisionData& data, const fcl::CollisionGeometryd* g1,
+                       const fcl::Transform3d& t1, const fcl::CollisionGeometryd* g2,
+                       const fcl::Transform3d& t2) {
+  data.result.clear();
+  if (fcl::collide(g1, t1, g2, t2, data.request, data.result) > 0) return 0;
+  data.distance_result.clear();
+  const double d = fcl::distance(g1, t1, g2, t2, data.distance_request, data.distance_result);
+  return std::max(0.0, d);
+}
+
+bool self_collides(const CollisionModel& model, CollisionData& data, int a, int b) {
+  if (!spheres_may_touch(data, model, a, b, model.margin)) return false;
+  return narrow_collide(data, model.robot[a].inflated.get(), data.transform[a],
+                        model.robot[b].exact.get(), data.transform[b]);
+}
+
+bool env_collides(const CollisionModel& model, CollisionData& data, int a, int o) {
+  const CollisionModel::ObstacleShape& obstacle = model.obstacles[o];
+  if (!sphere_may_touch_box(data.sphere_centre[a], model.robot[a].sphere_radius + model.margin,
+                            obstacle)) {
+    return false;
+  }
+  return narrow_collide(data, model.robot[a].inflated.get(), data.transform[a],
+                        obstacle.geometry.get(), obstacle.transform);
+}
+
+}  // namespace
+
+CollisionModel build_collision_model(const RobotModel& robot, const Environment& env,
+                                     const CollisionOptions& options) {
+  CollisionModel model;
+  model.margin = robot.collision_margin;
+  for (const CollisionBody& cb : robot.collision_bodies) {
+    CollisionModel::RobotShape s;
+    s.name = cb.name;
+    s.link = cb.link;
+    s.body = robot.links[cb.link].body;
+    s.in_body = robot.links[cb.link].in_body * cb.in_link;
+    s.exact = make_geometry(cb.shape, 0);
+    s.inflated = make_geometry(cb.shape, model.margin);
+    s.sphere_radius = bounding_radius(cb.shape);
+    model.robot.push_back(s);
+  }
+  for (const Obstacle& o : env.obstacles) {
+    CollisionModel::ObstacleShape s;
+    s.name = o.name;
+    s.pose = o.pose;
+    s.transform = to_fcl(o.pose);
+    s.geometry = make_geometry(o.shape, 0);
+    s.half_extents = bounding_half_extents(o.shape);
+    model.obstacles.push_back(s);
+  }
+  const int n = static_cast<int>(model.robot.size());
+  for (int a = 0; a < n; ++a) {
+    for (int b = a + 1; b < n; ++b) {
+      const auto& sa = model.robot[a];
+      const auto& sb = model.robot[b];
+      if (sa.body == sb.body) continue;  // rigidly joined: their distance never changes
+      if (!options.ignore_allowed_pairs && robot.is_allowed_pair(sa.link, sb.link)) continue;
+      model.self_pairs.emplace_back(a, b);
+    }
+  }
+  for (size_t o = 0; o < env.obstacles.size(); ++o) {
+    std::vector<int> allowed;
+    for (const std::string& name : env.obstacles[o].allowed_links) {
+      const int link = robot.link_index(name);
+      if (link < 0) {
+        fail(env.path, "object '" + env.obstacles[o].name + "': allowed link '" + name +
+                           "' is not a link of robot '" + robot.name + "'");
+      }
+      allowed.push_back(link);
+    }
+    for (int a = 0; a < n; ++a) {
+      if (std::find(allowed.begin(), allowed.end(), model.robot[a].link) != allowed.end()) continue;
+      model.env_pairs.emplace_back(a, static_cast<int>(o));
+    }
+  }
+  return model;
+}
+
+CollisionData::CollisionData(const CollisionModel& model)
+    : transform(model.robot.size(), fcl::Transform3d::Identity()),
+      sphere_centre(model.robot.size(), Eigen::Vector3d::Zero()) {
+  request.num_max_contacts = 1;
+  request.enable_contact = false;
+  result.clear();
+}
+
+void update_collision_transforms(const CollisionModel& model, CollisionData& data,
+                                 const RobotData& robot_data) {
+  for (size_t a = 0; a < model.robot.size(); ++a) {
+    const CollisionModel::RobotShape& s = model.robot[a];
+    const Pose world = s.body < 0 ? s.in_body : robot_data.body_pose[s.body] * s.in_body;
+    data.transform[a].linear() = world.R;
+    data.transform[a].translation() = world.p;
+    data.sphere_centre[a] = world.p;  // every shape is centred on its own frame origin
+  }
+}
+
+bool in_collision(const CollisionModel& model, CollisionData& data) {
+  for (const auto& [a, o] : model.env_pairs) {
+    if (env_collides(model, data, a, o)) return true;
+  }
+  for (const auto& [a, b] : model.self_pairs) {
+    if (self_collides(model, data, a, b)) return true;
+  }
+  return false;
+}
+
+CollisionReport check_collision(const CollisionModel& model, CollisionData& data) {
+  CollisionReport report;
+  for (const auto& [a, o] : model.env_pairs) {
+    if (env_collides(model, data, a, o)) {
+      report.env_collision = true;
+      report.first_a = a;
+      report.first_b = o;
+      break;
+    }
+  }
+  for (const auto& [a, b] : model.self_pairs) {
+    if (self_collides(model, data, a, b)) {
+      report.self_collision = true;
+      if (report.first_a < 0) {
+        report.first_a = a;
+        report.first_b = b;
+      }
+      break;
+    }
+  }
+  return report;
+}
+
+DistanceReport min_distance(const CollisionModel& model, CollisionData& data) {
+  DistanceReport report;
+  for (const auto& [a, o] : model.env_pairs) {
+    report.env_distance = std::min(
+        report.env_distance,
+        narrow_distance(data, model.robot[a].exact.get(), data.transform[a],
+                        model.obstacles[o].geometry.get(), model.obstacles[o].transform));
+  }
+  for (const auto& [a, b] : model.self_pairs) {
+    report.self_distance =
+        std::min(report.self_distance,
+                 narrow_distance(data, model.robot[a].exact.get(), data.transform[a],
+                                 model.robot[b].exact.get(), data.transform[b]));
+  }
+  return report;
+}
+
+bool self_pair_collides(const CollisionModel& model, CollisionData& data, int shape_a,
+                        int shape_b) {
+  return self_collides(model, data, shape_a, shape_b);
+}
+
+}  // namespace lazyboe

@@ -1,0 +1,95 @@
+// Self- and environment collision of the robot with FCL. The FCL shapes and the list of pairs
+// to test are built once (CollisionModel, read-only, shared by threads); a query only moves
+// transforms in a per-thread CollisionData. Bounding spheres (robot) and boxes (obstacles)
+// cull most pairs before FCL's narrow phase runs.
+//
+// Margin: a configuration is in collision when any tested pair is closer than the robot's
+// collision margin. One side of each pair is inflated by the margin, which is exact for
+// spheres and capsules and conservative for boxes and cylinders.
+#pragma once
+
+#include <fcl/fcl.h>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "collision/environment.h"
+#include "robot/kinematics.h"
+
+namespace lazyboe {
+
+struct CollisionModel {
+  struct RobotShape {
+    std::string name;
+    int link = 0;
+    int body = -1;  // -1: fixed to the base
+    Pose in_body;
+    std::shared_ptr<fcl::CollisionGeometryd> exact, inflated;
+    Eigen::Vector3d sphere_centre = Eigen::Vector3d::Zero();  // in the shape frame
+    double sphere_radius = 0;                                  // exact shape
+  };
+  struct ObstacleShape {
+    std::string name;
+    fcl::Transform3d transform;
+    Pose pose;
+    std::shared_ptr<fcl::CollisionGeometryd> geometry;
+    Eigen::Vector3d half_extents;  // of the box bounding it, in its own frame
+  };
+
+  double margin = 0;
+  std::vector<RobotShape> robot;
+  std::vector<ObstacleShape> obstacles;
+  std::vector<std::pair<int, int>> self_pairs;  // robot shape indices
+  std::vector<std::pair<int, int>> env_pairs;   // (robot shape, obstacle)
+};
+
+struct CollisionOptions {
+  bool ignore_allowed_pairs = false;  // test every pair of links on different bodies
+};
+
+// Throws Error when the environment names a link the robot does not have.
+CollisionModel build_collision_model(const RobotModel& robot, const Environment& env,
+                                     const CollisionOptions& options = {});
+
+// Per-thread scratch.
+struct CollisionData {
+  explicit CollisionData(const CollisionModel& model);
+  std::vector<fcl::Transform3d> transform;     // robot shapes in the base frame
+  std::vector<Eigen::Vector3d> sphere_centre;  // bounding-sphere centres in the base frame
+  fcl::CollisionRequestd request;
+  fcl::CollisionResultd result;
+  fcl::DistanceRequestd distance_request;
+  fcl::DistanceResultd distance_result;
+};
+
+struct CollisionReport {
+  bool self_collision = false;
+  bool env_collision = false;
+  int first_a = -1, first_b = -1;  // first colliding pair found (robot shape, shape/obstacle)
+  bool any() const { return self_collision || env_collision; }
+};
+
+struct DistanceReport {
+  double self_distance = std::numeric_limits<double>::infinity();
+  double env_distance = std::numeric_limits<double>::infinity();
+  double min() const { return std::min(self_distance, env_distance); }
+};
+
+// Places the robot shapes from the body poses of the last forward_kinematics(robot_data).
+void update_collision_transforms(const CollisionModel& model, CollisionData& data,
+                                 const RobotData& robot_data);
+
+// True when any tested pair is closer than the margin. Stops at the first one found.
+bool in_collision(const CollisionModel& model, CollisionData& data);
+
+// Both flags (self and environment), each search stopping at its first hit.
+CollisionReport check_collision(const CollisionModel& model, CollisionData& data);
+
+// Exact distances (no margin) over the tested pairs; 0 for touching or overlapping shapes.
+DistanceReport min_distance(const CollisionModel& model, CollisionData& data);
+
+// Collision of one specific pair (used by the allowed-pair derivation).
+bool self_pair_collides(const CollisionModel& model, CollisionData& data, int shape_a, int shape_b);
+
+}  // namespace lazyboe

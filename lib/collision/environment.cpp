@@ -1,0 +1,69 @@
+#include "collision/environment.h"
+
+#include <set>
+
+#include "common/json_fields.h"
+
+namespace lazyboe {
+
+std::string default_environment_path() { return data_dir() + "/environments/table.json"; }
+
+Environment load_environment(const std::string& path) {
+  const nlohmann::json doc = load_json_file(path);
+  const JsonField root(doc, path, "");
+  root.allow_only({"schema_version", "name", "description", "objects"});
+  if (root.at("schema_version").integer() != 1) {
+    root.at("schema_version").fail("unsupported version (this build reads version 1)");
+  }
+  Environment env;
+  env.path = path;
+  env.name = root.at("name").string();
+  if (root.has("description")) env.description = root.at("description").string();
+  std::set<std::string> names;
+  for (const JsonField& item : root.at("objects").items()) {
+    Obstacle o;
+    o.name = item.at("name").string();
+    if (!names.insert(o.name).second) item.at("name").fail("duplicate object name '" + o.name + "'");
+    const std::string type = item.at("type").string();
+    if (type == "box") {
+      item.allow_only({"name", "type", "size", "position", "rpy", "quaternion", "allowed_links"});
+      o.shape.type = ShapeType::Box;
+      o.shape.size = item.at("size").vec3();
+      if (!(o.shape.size.minCoeff() > 0)) item.at("size").fail("every extent must be > 0");
+    } else if (type == "sphere") {
+      item.allow_only({"name", "type", "radius", "position", "allowed_links"});
+      o.shape.type = ShapeType::Sphere;
+      o.shape.radius = item.at("radius").positive();
+    } else if (type == "cylinder" || type == "capsule") {
+      item.allow_only({"name", "type", "radius", "length", "position", "rpy", "quaternion",
+                       "allowed_links"});
+      o.shape.type = type == "cylinder" ? ShapeType::Cylinder : ShapeType::Capsule;
+      o.shape.radius = item.at("radius").positive();
+      o.shape.length = item.at("length").positive();
+    } else {
+      item.at("type").fail("unknown object type '" + type +
+                           "' (expected box, sphere, cylinder or capsule)");
+    }
+    o.pose.p = item.at("position").vec3();
+    if (item.has("rpy") && item.has("quaternion")) item.fail("give rpy or quaternion, not both");
+    if (item.has("rpy")) {
+      const Eigen::Vector3d rpy = item.at("rpy").vec3();
+      o.pose.R = rotation_from_rpy(rpy.x(), rpy.y(), rpy.z());
+    } else if (item.has("quaternion")) {
+      const std::vector<double> q = item.at("quaternion").numbers();
+      if (q.size() != 4) item.at("quaternion").fail("expected 4 numbers [w, x, y, z]");
+      Eigen::Quaterniond quat(q[0], q[1], q[2], q[3]);
+      if (!(quat.norm() > 1e-9)) item.at("quaternion").fail("must not be zero");
+      o.pose.R = quat.normalized().toRotationMatrix();
+    }
+    if (item.has("allowed_links")) {
+      for (const JsonField& link : item.at("allowed_links").items()) {
+        o.allowed_links.push_back(link.string());
+      }
+    }
+    env.obstacles.push_back(o);
+  }
+  return env;
+}
+
+}  // namespace lazyboe

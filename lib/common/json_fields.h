@@ -1,0 +1,45 @@
+// Reading JSON input files with errors that name the file and the field path
+// (for example "table.json: objects[2].size: expected 3 numbers").
+#pragma once
+
+#include <Eigen/Core>
+#include <initializer_list>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+namespace lazyboe {
+
+// Parses a whole JSON file; a syntax error names the line and column.
+nlohmann::json load_json_file(const std::string& path);
+
+// A view of one JSON value with the file and path it came from.
+class JsonField {
+ public:
+  JsonField(const nlohmann::json& value, std::string file, std::string path);
+
+  const std::string& path() const { return path_; }
+  [[noreturn]] void fail(const std::string& what) const;
+
+  bool has(const std::string& key) const;
+  JsonField at(const std::string& key) const;  // required member
+  std::vector<JsonField> items() const;        // elements of an array
+  // Rejects members other than these, so a misspelt optional field is not silently ignored.
+  void allow_only(std::initializer_list<const char*> keys) const;
+
+  double number() const;  // finite
+  double number_at_least(double min) const;
+  double positive() const;
+  long integer() const;
+  bool boolean() const;
+  std::string string() const;
+  Eigen::Vector3d vec3() const;
+  std::vector<double> numbers() const;
+
+ private:
+  const nlohmann::json* value_;
+  std::string file_;
+  std::string path_;
+};
+
+}  // namespace lazyboe

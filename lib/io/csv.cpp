@@ -1,0 +1,123 @@
+#include "io/csv.h"
+
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+#include <unistd.h>
+
+#include "common/error.h"
+
+namespace lazyboe {
+namespace {
+
+std::string trim(const std::string& s) {
+  const size_t b = s.find_first_not_of(" \t\r");
+  if (b == std::string::npos) return "";
+  const size_t e = s.find_last_not_of(" \t\r");
+  return s.substr(b, e - b + 1);
+}
+
+std::vector<std::string> split(const std::string& line) {
+  std::vector<std::string> cells;
+  std::stringstream ss(line);
+  std::string cell;
+  while (std::getline(ss, cell, ',')) cells.push_back(trim(cell));
+  if (!line.empty() && line.back() == ',') cells.push_back("");
+  return cells;
+}
+
+std::string join(const std::vector<std::string>& v) {
+  std::string out;
+  for (size_t i = 0; i < v.size(); ++i) out += (i ? "," : "") + v[i];
+  return out;
+}
+
+}  // namespace
+
+std::vector<std::string> numbered_columns(const std::string& prefix, int n) {
+  std::vector<std::string> out;
+  for (int i = 1; i <= n; ++i) out.push_back(prefix + std::to_string(i));
+  return out;
+}
+
+CsvTable read_numeric_csv(const std::string& path, const std::vector<std::string>& expected_header) {
+  std::ifstream in(path);
+  if (!in) fail(path, "cannot open file");
+  CsvTable table;
+  std::string line;
+  int line_no = 0;
+  bool have_header = false;
+  while (std::getline(in, line)) {
+    ++line_no;
+    if (trim(line).empty()) continue;
+    const std::vector<std::string> cells = split(line);
+    const std::string where = path + ":" + std::to_string(line_no);
+    if (!have_header) {
+      if (cells != expected_header) {
+        fail(where, "header must be '" + join(expected_header) + "' (got '" + trim(line) + "')");
+      }
+      table.header = cells;
+      have_header = true;
+      continue;
+    }
+    if (cells.size() != expected_header.size()) {
+      fail(where, "expected " + std::to_string(expected_header.size()) + " columns, got " +
+                      std::to_string(cells.size()));
+    }
+    std::vector<double> row(cells.size());
+    for (size_t c = 0; c < cells.size(); ++c) {
+      const char* text = cells[c].c_str();
+      char* end = nullptr;
+      errno = 0;
+      const double v = std::strtod(text, &end);
+      if (cells[c].empty() || end == text || *end != '\0') {
+        fail(where, "column '" + expected_header[c] + "': not a number ('" + cells[c] + "')");
+      }
+      if (!std::isfinite(v) || errno == ERANGE) {
+        fail(where, "column '" + expected_header[c] + "': value must be finite ('" + cells[c] + "')");
+      }
+      row[c] = v;
+    }
+    table.rows.push_back(std::move(row));
+    table.line.push_back(line_no);
+  }
+  if (!have_header) fail(path, "empty file (expected header '" + join(expected_header) + "')");
+  return table;
+}
+
+CsvWriter::CsvWriter(const std::string& path, const std::vector<std::string>& header)
+    : path_(path), tmp_path_(path + ".tmp." + std::to_string(::getpid())), columns_(header.size()) {
+  file_ = std::fopen(tmp_path_.c_str(), "w");
+  if (!file_) fail(path, std::string("cannot write: ") + std::strerror(errno));
+  std::fprintf(file_, "%s\n", join(header).c_str());
+}
+
+CsvWriter::~CsvWriter() {
+  if (file_) {  // not committed: drop the partial file
+    std::fclose(file_);
+    std::remove(tmp_path_.c_str());
+  }
+}
+
+void CsvWriter::row(const std::vector<double>& values) {
+  if (values.size() != columns_) fail(path_, "internal error: row width differs from header");
+  for (size_t i = 0; i < values.size(); ++i) {
+    std::fprintf(file_, i + 1 < values.size() ? "%.10g," : "%.10g\n", values[i]);
+  }
+}
+
+void CsvWriter::commit() {
+  const bool ok = std::fflush(file_) == 0 && ::fsync(fileno(file_)) == 0;
+  std::fclose(file_);
+  file_ = nullptr;
+  if (!ok || std::rename(tmp_path_.c_str(), path_.c_str()) != 0) {
+    std::remove(tmp_path_.c_str());
+    fail(path_, std::string("cannot write: ") + std::strerror(errno));
+  }
+}
+
+}  // namespace lazyboe

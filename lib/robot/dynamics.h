@@ -1,0 +1,41 @@
+// Rigid-body dynamics of the chain, tau = M(q) ddq + C(q, dq) dq + g(q) + tau_f(dq), as small
+// free functions over (RobotModel, RobotData). Results are written into the data workspace and
+// returned by reference; nothing allocates.
+#pragma once
+
+#include "robot/kinematics.h"
+
+namespace lazyboe {
+
+// Full inverse dynamics by recursive Newton-Euler, friction included.
+const JointVector& inverse_dynamics(const RobotModel& model, RobotData& data,
+                                    const JointVectorRef& q, const JointVectorRef& dq,
+                                    const JointVectorRef& ddq);
+
+// Recursive Newton-Euler with gravity and friction switchable (for tests and for h(q, dq)).
+const JointVector& rnea(const RobotModel& model, RobotData& data, const JointVectorRef& q,
+                        const JointVectorRef& dq, const JointVectorRef& ddq, bool with_gravity,
+                        bool with_friction);
+
+// Joint-space mass matrix M(q) by the composite-rigid-body algorithm (data.M).
+const JointMatrix& mass_matrix(const RobotModel& model, RobotData& data, const JointVectorRef& q);
+
+// Gravity torques g(q) (data.gravity).
+const JointVector& gravity_torques(const RobotModel& model, RobotData& data,
+                                   const JointVectorRef& q);
+
+// Friction torques tau_f(dq) (data.friction).
+const JointVector& friction_torques(const RobotModel& model, RobotData& data,
+                                    const JointVectorRef& dq);
+double friction_torque(const Friction& friction, double dq);
+
+// Forward dynamics: ddq = M^-1 (tau - C dq - g - tau_f) (data.ddq).
+const JointVector& forward_dynamics(const RobotModel& model, RobotData& data,
+                                    const JointVectorRef& q, const JointVectorRef& dq,
+                                    const JointVectorRef& tau);
+
+double kinetic_energy(const RobotModel& model, RobotData& data, const JointVectorRef& q,
+                      const JointVectorRef& dq);
+double potential_energy(const RobotModel& model, RobotData& data, const JointVectorRef& q);
+
+}  // namespace lazyboe

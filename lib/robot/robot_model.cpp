@@ -1,0 +1,447 @@
+#include "robot/robot_model.h"
+
+#include <console_bridge/console.h>
+#include <tinyxml.h>
+#include <urdf_parser/urdf_parser.h>
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/LU>
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <map>
+#include <set>
+#include <sstream>
+
+#include "common/error.h"
+#include "common/json_fields.h"
+#include "robot/dynamics.h"
+#include "robot/kinematics.h"
+
+namespace lazyboe {
+namespace {
+
+namespace fs = std::filesystem;
+
+// urdfdom reports parse problems through console_bridge; keep the last error for our message
+// instead of letting it print to the terminal.
+class CapturingOutputHandler : public console_bridge::OutputHandler {
+ public:
+  void log(const std::string& text, console_bridge::LogLevel level, const char*, int) override {
+    if (level >= console_bridge::CONSOLE_BRIDGE_LOG_ERROR) last_error = text;
+  }
+  std::string last_error;
+};
+
+Pose pose_from_urdf(const urdf::Pose& pose) {
+  Eigen::Quaterniond rotation(pose.rotation.w, pose.rotation.x, pose.rotation.y,
+                              pose.rotation.z);
+  return Pose(rotation.normalized().toRotationMatrix(),
+              Eigen::Vector3d(pose.position.x, pose.position.y, pose.position.z));
+}
+
+urdf::ModelInterfaceSharedPtr parse_urdf_file(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) fail(path, "cannot open URDF file");
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  // urdfdom drops the XML parser's line number; parse once more to report where XML breaks.
+  TiXmlDocument xml;
+  xml.Parse(buffer.str().c_str());
+  if (xml.Error()) {
+    fail(path + ":" + std::to_string(xml.ErrorRow()) + ":" + std::to_string(xml.ErrorCol()),
+         std::string("malformed XML (") + xml.ErrorDesc() + ")");
+  }
+  CapturingOutputHandler handler;
+  console_bridge::useOutputHandler(&handler);
+  urdf::ModelInterfaceSharedPtr urdf_model = urdf::parseURDF(buffer.str());
+  console_bridge::restorePreviousOutputHandler();
+  if (!urdf_model) {
+    fail(path, "not a valid URDF" + (handler.last_error.empty() ? std::string()
+                                                                 : " (" + handler.last_error + ")"));
+  }
+  return urdf_model;
+}
+
+void check_inertial(const std::string& urdf_path, const urdf::Link& link) {
+  if (!link.inertial) return;
+  const urdf::Inertial& in = *link.inertial;
+  const std::string where = urdf_path + ": link '" + link.name + "'";
+  const double values[] = {in.mass, in.ixx, in.ixy, in.ixz, in.iyy, in.iyz, in.izz};
+  for (double v : values) {
+    if (!std::isfinite(v)) fail(where, "inertial values must be finite");
+  }
+  if (in.mass < 0) fail(where, "mass must be >= 0, got " + std::to_string(in.mass));
+  Eigen::Matrix3d I;
+  I << in.ixx, in.ixy, in.ixz, in.ixy, in.iyy, in.iyz, in.ixz, in.iyz, in.izz;
+  const Eigen::Vector3d eig = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(I).eigenvalues();
+  const double tol = 1e-9 * std::max(1.0, eig.cwiseAbs().maxCoeff());
+  if (eig.minCoeff() < -tol) {
+    fail(where, "inertia is not physical (not positive semi-definite)");
+  }
+  // Principal moments of a real body satisfy the triangle inequality.
+  if (eig(0) + eig(1) < eig(2) - tol || eig(0) + eig(2) < eig(1) - tol ||
+      eig(1) + eig(2) < eig(0) - tol) {
+    fail(where, "inertia is not physical (principal moments violate the triangle inequality)");
+  }
+}
+
+Friction read_friction(const JsonField& f) {
+  Friction friction;
+  const std::string model = f.at("model").string();
+  if (model == "none") {
+    f.allow_only({"model"});
+  } else if (model == "sigmoid") {
+    f.allow_only({"model", "fi1", "fi2", "fi3"});
+    friction.model = FrictionModel::Sigmoid;
+    friction.a = f.at("fi1").number();
+    friction.b = f.at("fi2").number();
+    friction.c = f.at("fi3").number();
+  } else if (model == "viscous_coulomb") {
+    f.allow_only({"model", "coulomb", "viscous", "smoothing_velocity"});
+    friction.model = FrictionModel::ViscousCoulomb;
+    friction.a = f.at("coulomb").number_at_least(0);
+    friction.b = f.at("viscous").number_at_least(0);
+    friction.c = f.at("smoothing_velocity").positive();
+  } else {
+    f.at("model").fail("unknown friction model '" + model +
+                       "' (expected none, sigmoid or viscous_coulomb)");
+  }
+  return friction;
+}
+
+// Collision elements of one URDF link. A cylinder capped by two spheres of its radius at its
+// ends is the usual URDF spelling of a capsule; it becomes one capsule (cheaper and exact).
+void add_collision_bodies(RobotModel& model, const std::string& urdf_path,
+                          const urdf::Link& link, int link_index) {
+  struct Element {
+    std::string name;
+    Shape shape;
+    Pose pose;
+    bool used = false;
+  };
+  std::vector<Element> elements;
+  for (size_t k = 0; k < link.collision_array.size(); ++k) {
+    const urdf::Collision& c = *link.collision_array[k];
+    const std::string where = urdf_path + ": link '" + link.name + "' collision " +
+                              std::to_string(k);
+    if (!c.geometry) fail(where, "missing geometry");
+    Element e;
+    e.name = c.name.empty() ? link.name + "_" + std::to_string(k) : c.name;
+    e.pose = pose_from_urdf(c.origin);
+    switch (c.geometry->type) {
+      case urdf::Geometry::SPHERE: {
+        e.shape.type = ShapeType::Sphere;
+        e.shape.radius = static_cast<const urdf::Sphere&>(*c.geometry).radius;
+        if (!(e.shape.radius > 0)) fail(where, "sphere radius must be > 0");
+        break;
+      }
+      case urdf::Geometry::BOX: {
+        const urdf::Vector3& dim = static_cast<const urdf::Box&>(*c.geometry).dim;
+        e.shape.type = ShapeType::Box;
+        e.shape.size = Eigen::Vector3d(dim.x, dim.y, dim.z);
+        if (!(e.shape.size.minCoeff() > 0)) fail(where, "box size must be > 0");
+        break;
+      }
+      case urdf::Geometry::CYLINDER: {
+        const auto& cyl = static_cast<const urdf::Cylinder&>(*c.geometry);
+        e.shape.type = ShapeType::Cylinder;
+        e.shape.radius = cyl.radius;
+        e.shape.length = cyl.length;
+        if (!(cyl.radius > 0 && cyl.length > 0)) fail(where, "cylinder size must be > 0");
+        break;
+      }
+      default:
+        fail(where,
+             "only sphere, box and cylinder collision geometry is supported (write a capsule "
+             "as a cylinder plus two spheres; replace meshes by primitives)");
+    }
+    elements.push_back(e);
+  }
+  const double tol = 1e-6;
+  for (Element& cyl : elements) {
+    if (cyl.shape.type != ShapeType::Cylinder) continue;
+    const Eigen::Vector3d axis = cyl.pose.R.col(2);
+    const double half = cyl.shape.length / 2;
+    Element* caps[2] = {nullptr, nullptr};
+    for (int end = 0; end < 2; ++end) {
+      const Eigen::Vector3d centre = cyl.pose.p + (end == 0 ? half : -half) * axis;
+      for (Element& s : elements) {
+        if (!s.used && s.shape.type == ShapeType::Sphere &&
+            std::abs(s.shape.radius - cyl.shape.radius) < tol && (s.pose.p - centre).norm() < tol) {
+          caps[end] = &s;
+          break;
+        }
+      }
+    }
+    if (caps[0] && caps[1] && caps[0] != caps[1]) {
+      caps[0]->used = caps[1]->used = true;
+      cyl.shape.type = ShapeType::Capsule;
+      for (const char* suffix : {"_cylinder", "_cyl"}) {
+        const size_t n = std::string(suffix).size();
+        if (cyl.name.size() > n && cyl.name.compare(cyl.name.size() - n, n, suffix) == 0) {
+          cyl.name.resize(cyl.name.size() - n);
+          break;
+        }
+      }
+    }
+  }
+  for (const Element& e : elements) {
+    if (e.used) continue;
+    model.collision_bodies.push_back({e.name, link_index, e.shape, e.pose});
+  }
+}
+
+void read_config_joints(RobotModel& model, const JsonField& root) {
+  std::vector<JsonField> entries = root.at("joints").items();
+  std::set<std::string> seen;
+  for (const JsonField& entry : entries) {
+    entry.allow_only({"name", "max_acceleration", "max_jerk", "max_torque_rate", "friction"});
+    const std::string name = entry.at("name").string();
+    auto it = std::find_if(model.joints.begin(), model.joints.end(),
+                           [&](const Joint& j) { return j.name == name; });
+    if (it == model.joints.end()) {
+      entry.at("name").fail("'" + name + "' is not a moving joint of the chain");
+    }
+    if (!seen.insert(name).second) entry.at("name").fail("joint '" + name + "' listed twice");
+    it->max_acceleration = entry.at("max_acceleration").positive();
+    it->max_jerk = entry.at("max_jerk").positive();
+    it->max_torque_rate = entry.at("max_torque_rate").positive();
+    it->friction = read_friction(entry.at("friction"));
+  }
+  for (const Joint& j : model.joints) {
+    if (!seen.count(j.name)) root.at("joints").fail("no entry for joint '" + j.name + "'");
+  }
+}
+
+}  // namespace
+
+void merge_inertia(BodyInertia& into, double mass, const Eigen::Vector3d& com,
+                   const Eigen::Matrix3d& inertia_com) {
+  const double total = into.mass + mass;
+  if (total <= 0) return;
+  const Eigen::Vector3d c = (into.mass * into.com + mass * com) / total;
+  auto shift = [](double m, const Eigen::Vector3d& d) {
+    return m * (d.squaredNorm() * Eigen::Matrix3d::Identity() - d * d.transpose());
+  };
+  into.inertia_com = into.inertia_com + shift(into.mass, into.com - c) + inertia_com +
+                     shift(mass, com - c);
+  into.com = c;
+  into.mass = total;
+}
+
+const char* shape_type_name(ShapeType type) {
+  switch (type) {
+    case ShapeType::Sphere: return "sphere";
+    case ShapeType::Box: return "box";
+    case ShapeType::Cylinder: return "cylinder";
+    case ShapeType::Capsule: return "capsule";
+  }
+  return "?";
+}
+
+int RobotModel::link_index(const std::string& link_name) const {
+  for (size_t i = 0; i < links.size(); ++i) {
+    if (links[i].name == link_name) return static_cast<int>(i);
+  }
+  return -1;
+}
+
+bool RobotModel::is_allowed_pair(int link_a, int link_b) const {
+  const std::pair<int, int> key(std::min(link_a, link_b), std::max(link_a, link_b));
+  return std::binary_search(allowed_pairs.begin(), allowed_pairs.end(), key);
+}
+
+std::string data_dir() {
+  if (const char* env = std::getenv("LAZYBOE_DATA_DIR"); env && *env) return env;
+  return LAZYBOE_DATA_DIR;
+}
+
+std::string default_robot_path() { return data_dir() + "/robots/panda.json"; }
+
+RobotModel load_robot(const std::string& config_path) {
+  const nlohmann::json config = load_json_file(config_path);
+  const JsonField root(config, config_path, "");
+  root.allow_only({"schema_version", "name", "description", "urdf", "base_link", "tip_link",
+                   "gravity", "control_rate", "joints", "collision", "controller"});
+  if (root.at("schema_version").integer() != 1) {
+    root.at("schema_version").fail("unsupported version (this build reads version 1)");
+  }
+
+  RobotModel model;
+  model.config_path = config_path;
+  model.name = root.at("name").string();
+  const std::string urdf_rel = root.at("urdf").string();
+  model.urdf_path = (fs::path(config_path).parent_path() / urdf_rel).lexically_normal().string();
+  if (root.has("gravity")) model.gravity = root.at("gravity").vec3();
+  if (root.has("control_rate")) {
+    const long rate = root.at("control_rate").integer();
+    if (rate <= 0) root.at("control_rate").fail("must be > 0");
+    model.control_rate = static_cast<double>(rate);
+  }
+
+  const urdf::ModelInterfaceSharedPtr urdf_model = parse_urdf_file(model.urdf_path);
+  const std::string& upath = model.urdf_path;
+
+  // The chain: from base_link (default: the URDF root) to tip_link (default: follow the only
+  // child until the tree ends).
+  const std::string base_name =
+      root.has("base_link") ? root.at("base_link").string() : urdf_model->getRoot()->name;
+  urdf::LinkConstSharedPtr base = urdf_model->getLink(base_name);
+  if (!base) root.at("base_link").fail("no link '" + base_name + "' in " + upath);
+  std::vector<urdf::LinkConstSharedPtr> chain;  // base ... tip
+  if (root.has("tip_link")) {
+    const std::string tip_name = root.at("tip_link").string();
+    urdf::LinkConstSharedPtr link = urdf_model->getLink(tip_name);
+    if (!link) root.at("tip_link").fail("no link '" + tip_name + "' in " + upath);
+    while (link && link != base) {
+      chain.push_back(link);
+      link = link->getParent();
+    }
+    if (!link) root.at("tip_link").fail("'" + tip_name + "' is not below '" + base_name + "'");
+    chain.push_back(base);
+    std::reverse(chain.begin(), chain.end());
+  } else {
+    urdf::LinkConstSharedPtr link = base;
+    chain.push_back(link);
+    while (!link->child_links.empty()) {
+      if (link->child_links.size() > 1) {
+        fail(config_path, "the URDF branches at link '" + link->name +
+                              "'; set tip_link to choose the chain");
+      }
+      link = link->child_links[0];
+      chain.push_back(link);
+    }
+  }
+
+  // Walk the chain: a moving joint starts a new body; fixed joints merge into the current one.
+  // Links hanging off the chain through fixed joints join their body too.
+  std::set<std::string> on_chain;
+  for (const auto& l : chain) on_chain.insert(l->name);
+  int body = -1;
+  std::vector<urdf::LinkConstSharedPtr> link_sources;
+  std::function<void(const urdf::LinkConstSharedPtr&, const Pose&)> add_link =
+      [&](const urdf::LinkConstSharedPtr& link, const Pose& in_body) {
+        check_inertial(upath, *link);
+        const int index = static_cast<int>(model.links.size());
+        model.links.push_back({link->name, body, in_body});
+        link_sources.push_back(link);
+        if (body >= 0 && link->inertial) {
+          const Pose inertial = in_body * pose_from_urdf(link->inertial->origin);
+          Eigen::Matrix3d I;
+          const urdf::Inertial& in = *link->inertial;
+          I << in.ixx, in.ixy, in.ixz, in.ixy, in.iyy, in.iyz, in.ixz, in.iyz, in.izz;
+          merge_inertia(model.bodies[body], in.mass, inertial.p,
+                        inertial.R * I * inertial.R.transpose());
+        }
+        (void)index;
+        for (const auto& child : link->child_links) {
+          if (on_chain.count(child->name)) continue;
+          const urdf::Joint& j = *child->parent_joint;
+          if (j.type == urdf::Joint::FIXED) {
+            add_link(child, in_body * pose_from_urdf(j.parent_to_joint_origin_transform));
+          } else {
+            model.ignored_links.push_back(child->name);
+          }
+        }
+      };
+  Pose in_body;  // current chain link in the current body frame
+  for (size_t k = 0; k < chain.size(); ++k) {
+    const urdf::LinkConstSharedPtr& link = chain[k];
+    if (k > 0) {
+      const urdf::Joint& uj = *link->parent_joint;
+      const Pose origin = in_body * pose_from_urdf(uj.parent_to_joint_origin_transform);
+      const std::string where = upath + ": joint '" + uj.name + "'";
+      if (uj.type == urdf::Joint::FIXED) {
+        in_body = origin;
+      } else if (uj.type == urdf::Joint::REVOLUTE || uj.type == urdf::Joint::PRISMATIC) {
+        if (model.dof >= kMaxDof) {
+          fail(where, "chain has more than " + std::to_string(kMaxDof) + " moving joints");
+        }
+        Joint j;
+        j.name = uj.name;
+        j.type = uj.type == urdf::Joint::REVOLUTE ? JointType::Revolute : JointType::Prismatic;
+        j.origin = origin;
+        j.axis = Eigen::Vector3d(uj.axis.x, uj.axis.y, uj.axis.z);
+        if (!(j.axis.norm() > 1e-9)) fail(where, "axis must not be zero");
+        j.axis.normalize();
+        if (!uj.limits) fail(where, "missing <limit>");
+        j.lower = uj.limits->lower;
+        j.upper = uj.limits->upper;
+        j.max_velocity = uj.limits->velocity;
+        j.max_effort = uj.limits->effort;
+        if (!(std::isfinite(j.lower) && std::isfinite(j.upper) && j.lower < j.upper)) {
+          fail(where, "position limits must satisfy lower < upper");
+        }
+        if (!(j.max_velocity > 0)) fail(where, "velocity limit must be > 0");
+        if (!(j.max_effort > 0)) fail(where, "effort limit must be > 0");
+        model.joints.push_back(j);
+        model.bodies.emplace_back();
+        body = model.dof++;
+        in_body = Pose();
+      } else {
+        fail(where, "only revolute, prismatic and fixed joints are supported");
+      }
+    }
+    add_link(link, in_body);
+  }
+  if (model.dof == 0) fail(upath, "the chain from '" + base_name + "' has no moving joint");
+
+  read_config_joints(model, root);
+
+  const JsonField collision = root.at("collision");
+  collision.allow_only({"margin", "allowed_pairs"});
+  model.collision_margin = collision.at("margin").number_at_least(0);
+  for (size_t i = 0; i < model.links.size(); ++i) {
+    add_collision_bodies(model, upath, *link_sources[i], static_cast<int>(i));
+  }
+  if (collision.has("allowed_pairs")) {
+    for (const JsonField& pair : collision.at("allowed_pairs").items()) {
+      std::vector<JsonField> names = pair.items();
+      if (names.size() != 2) pair.fail("expected two link names");
+      int idx[2];
+      for (int k = 0; k < 2; ++k) {
+        const std::string n = names[k].string();
+        idx[k] = model.link_index(n);
+        if (idx[k] < 0) names[k].fail("unknown link '" + n + "'");
+      }
+      if (idx[0] == idx[1]) pair.fail("a pair needs two different links");
+      model.allowed_pairs.emplace_back(std::min(idx[0], idx[1]), std::max(idx[0], idx[1]));
+    }
+    std::sort(model.allowed_pairs.begin(), model.allowed_pairs.end());
+    model.allowed_pairs.erase(std::unique(model.allowed_pairs.begin(), model.allowed_pairs.end()),
+                              model.allowed_pairs.end());
+  }
+
+  const int n = model.dof;
+  for (JointVector* v : {&model.q_min, &model.q_max, &model.dq_max, &model.ddq_max,
+                         &model.dddq_max, &model.tau_max, &model.dtau_max}) {
+    v->resize(n);
+  }
+  for (int i = 0; i < n; ++i) {
+    const Joint& j = model.joints[i];
+    model.q_min[i] = j.lower;
+    model.q_max[i] = j.upper;
+    model.dq_max[i] = j.max_velocity;
+    model.ddq_max[i] = j.max_acceleration;
+    model.dddq_max[i] = j.max_jerk;
+    model.tau_max[i] = j.max_effort;
+    model.dtau_max[i] = j.max_torque_rate;
+  }
+
+  // A chain whose mass matrix is singular (a moving body with no mass or inertia about its
+  // axis) cannot be simulated; say so now rather than produce NaNs later.
+  RobotData data(model);
+  const JointVector mid = (model.q_min + model.q_max) / 2;
+  const JointMatrix& M = mass_matrix(model, data, mid);
+  Eigen::SelfAdjointEigenSolver<JointMatrix> eig(M);
+  if (!(eig.eigenvalues().minCoeff() > 1e-12)) {
+    fail(upath, "the mass matrix is singular: a moving body has no mass or inertia");
+  }
+  return model;
+}
+
+}  // namespace lazyboe

@@ -1,0 +1,101 @@
+// The robot description: a serial chain read from a URDF plus a robot config file (JSON) that
+// adds what URDF cannot hold. Built once, then read-only and shared by every thread; per-thread
+// scratch lives in RobotData (kinematics.h).
+#pragma once
+
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "robot/types.h"
+
+namespace lazyboe {
+
+enum class JointType { Revolute, Prismatic };
+
+// Joint friction torque as a function of joint velocity.
+//   Sigmoid (Gaz et al. 2019): a/(1+exp(-b(dq+c))) - a/(1+exp(-b c))
+//   ViscousCoulomb: a*tanh(dq/c) + b*dq   (a = Coulomb, b = viscous, c = smoothing velocity)
+enum class FrictionModel { None, Sigmoid, ViscousCoulomb };
+struct Friction {
+  FrictionModel model = FrictionModel::None;
+  double a = 0, b = 0, c = 0;
+};
+
+struct Joint {
+  std::string name;
+  JointType type = JointType::Revolute;
+  Pose origin;  // parent body frame -> joint frame at q = 0
+  Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();  // unit, in the joint (= child body) frame
+  double lower = 0, upper = 0;                      // position limits (rad or m)
+  double max_velocity = 0, max_acceleration = 0, max_jerk = 0;
+  double max_effort = 0, max_torque_rate = 0;
+  Friction friction;
+};
+
+// Inertia of one moving body (its link plus every link fixed to it), in the body frame.
+struct BodyInertia {
+  double mass = 0;
+  Eigen::Vector3d com = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d inertia_com = Eigen::Matrix3d::Zero();  // about the centre of mass
+};
+
+// Adds a rigid body (mass, centre of mass, inertia about it; all in `into`'s frame) to `into`.
+void merge_inertia(BodyInertia& into, double mass, const Eigen::Vector3d& com,
+                   const Eigen::Matrix3d& inertia_com);
+
+struct Link {
+  std::string name;
+  int body = -1;  // moving body the link is fixed to; -1 for the base
+  Pose in_body;   // link frame in the body frame
+};
+
+enum class ShapeType { Sphere, Box, Cylinder, Capsule };
+struct Shape {
+  ShapeType type = ShapeType::Sphere;
+  double radius = 0;                              // sphere, cylinder, capsule
+  double length = 0;                              // cylinder, capsule: along local z
+  Eigen::Vector3d size = Eigen::Vector3d::Zero();  // box: full extents
+};
+const char* shape_type_name(ShapeType type);
+
+struct CollisionBody {
+  std::string name;
+  int link = 0;   // index into RobotModel::links
+  Shape shape;
+  Pose in_link;   // shape frame in the link frame
+};
+
+struct RobotModel {
+  std::string name;
+  std::string config_path;
+  std::string urdf_path;
+  int dof = 0;
+  Eigen::Vector3d gravity{0, 0, -9.81};
+  double control_rate = 1000;  // Hz
+
+  std::vector<Joint> joints;         // chain order; joint i moves body i
+  std::vector<BodyInertia> bodies;   // size dof
+  std::vector<Link> links;           // every link of the chain, base first
+  std::vector<std::string> ignored_links;  // side branches behind moving joints
+  std::vector<CollisionBody> collision_bodies;
+  double collision_margin = 0;
+  std::vector<std::pair<int, int>> allowed_pairs;  // link indices, first < second, sorted
+
+  // Limits gathered as vectors for the validity checks.
+  JointVector q_min, q_max, dq_max, ddq_max, dddq_max, tau_max, dtau_max;
+
+  int link_index(const std::string& link_name) const;  // -1 when unknown
+  int tip_link() const { return static_cast<int>(links.size()) - 1; }
+  bool is_allowed_pair(int link_a, int link_b) const;
+};
+
+// Loads a robot config (JSON) and the URDF it points at. Throws Error naming the file and
+// field for anything missing, malformed or not physical.
+RobotModel load_robot(const std::string& config_path);
+
+// The bundled data directory (LAZYBOE_DATA_DIR in the environment overrides the built-in one).
+std::string data_dir();
+std::string default_robot_path();
+
+}  // namespace lazyboe

@@ -1,0 +1,214 @@
+// Collision: hand-made poses that must and must not collide (self and environment), the margin
+// at near-touching distances, excluded pairs, and agreement of the fast culled check with the
+// exact distances on many random configurations.
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "collision/allowed_pairs.h"
+#include "collision/collision_model.h"
+#include "common/error.h"
+#include "test_util.h"
+
+namespace lazyboe {
+namespace {
+
+JointVector q_of(std::initializer_list<double> values) {
+  JointVector q(static_cast<int>(values.size()));
+  int i = 0;
+  for (double v : values) q[i++] = v;
+  return q;
+}
+
+const JointVector kReady = q_of({0, -0.785, 0, -2.356, 0, 1.571, 0.785});
+
+struct Checker {
+  const RobotModel& robot;
+  CollisionModel model;
+  RobotData rd;
+  CollisionData cd;
+  Checker(const RobotModel& r, const Environment& env, CollisionOptions options = {})
+      : robot(r), model(build_collision_model(r, env, options)), rd(r), cd(model) {}
+  void set(const JointVector& q) {
+    forward_kinematics(robot, rd, q);
+    update_collision_transforms(model, cd, rd);
+  }
+  CollisionReport report(const JointVector& q) {
+    set(q);
+    return check_collision(model, cd);
+  }
+};
+
+Environment env_file(const std::string& name) {
+  return load_environment(test::source_path("data/environments/" + name + ".json"));
+}
+
+int shape_index(const CollisionModel& m, const std::string& name) {
+  for (size_t i = 0; i < m.robot.size(); ++i) {
+    if (m.robot[i].name == name) return static_cast<int>(i);
+  }
+  return -1;
+}
+
+TEST(Collision, ReadyPoseIsFreeInEveryEnvironment) {
+  for (const char* name : {"empty", "table", "shelf"}) {
+    Checker c(test::panda(), env_file(name));
+    const CollisionReport r = c.report(kReady);
+    EXPECT_FALSE(r.self_collision) << name;
+    EXPECT_FALSE(r.env_collision) << name;
+    EXPECT_GT(min_distance(c.model, c.cd).min(), c.model.margin) << name;
+  }
+}
+
+TEST(Collision, ArmReachingIntoTheTableCollides) {
+  Checker table(test::panda(), env_file("table"));
+  Checker empty(test::panda(), env_file("empty"));
+  // Shoulder pitched forward and elbow opened: the flange ends up below the tabletop (z 0.2).
+  const JointVector q = q_of({0, 1.2, 0, -0.8, 0, 1.5, 0});
+  RobotData rd(test::panda());
+  forward_kinematics(test::panda(), rd, q);
+  ASSERT_LT(link_pose(test::panda(), rd, test::panda().tip_link()).p.z(), 0.2);
+  const CollisionReport r = table.report(q);
+  EXPECT_TRUE(r.env_collision);
+  EXPECT_FALSE(r.self_collision);
+  EXPECT_FALSE(empty.report(q).env_collision);  // no table there
+}
+
+TEST(Collision, FoldedElbowSelfCollides) {
+  Checker c(test::panda(), env_file("empty"));
+  // Elbow folded to its limit with the wrist turned back into the upper arm.
+  const JointVector q = q_of({0, 0, 0, -3.0, 0, 0.2, 0});
+  const CollisionReport r = c.report(q);
+  EXPECT_TRUE(r.self_collision);
+  EXPECT_FALSE(r.env_collision);
+}
+
+TEST(Collision, AdjacentLinksOverlapButAreExcluded) {
+  const RobotModel& robot = test::panda();
+  Checker normal(robot, env_file("empty"));
+  CollisionOptions all_pairs;
+  all_pairs.ignore_allowed_pairs = true;
+  Checker unfiltered(robot, env_file("empty"), all_pairs);
+  // Neighbouring capsules overlap at their joints by design, in every configuration.
+  EXPECT_FALSE(normal.report(kReady).self_collision);
+  EXPECT_TRUE(unfiltered.report(kReady).self_collision);
+  const int l1 = shape_index(unfiltered.model, "link1_a"), l2 = shape_index(unfiltered.model, "link2_a");
+  ASSERT_GE(l1, 0);
+  ASSERT_GE(l2, 0);
+  EXPECT_TRUE(self_pair_collides(unfiltered.model, unfiltered.cd, l1, l2));
+  for (const auto& [a, b] : normal.model.self_pairs) {
+    EXPECT_FALSE(robot.is_allowed_pair(normal.model.robot[a].link, normal.model.robot[b].link));
+  }
+}
+
+TEST(Collision, FloorIsAllowedOnlyForTheBaseLinks) {
+  const RobotModel& robot = test::panda();
+  Checker c(robot, env_file("empty"));
+  const int link0 = robot.link_index("panda_link0"), link1 = robot.link_index("panda_link1");
+  for (const auto& [a, o] : c.model.env_pairs) {
+    EXPECT_NE(c.model.robot[a].link, link0);
+    EXPECT_NE(c.model.robot[a].link, link1);
+  }
+  EXPECT_FALSE(c.report(q_of({0, 0, 0, -0.1, 0, 0.1, 0})).any());
+}
+
+// A small sphere placed at a chosen distance d from the link7 capsule's surface: it collides
+// exactly when d is below the margin, and the reported distance is d.
+TEST(Collision, NearTouchingRespectsTheMargin) {
+  const RobotModel& robot = test::panda();
+  Checker probe(robot, Environment{});
+  probe.set(kReady);
+  const int s = shape_index(probe.model, "link7_a");
+  ASSERT_GE(s, 0);
+  const fcl::Transform3d& t = probe.cd.transform[s];
+  const double capsule_radius = 0.04, sphere_radius = 0.01;
+  const double margin = robot.collision_margin;
+  ASSERT_GT(margin, 0.002);
+  for (double d : {0.0005, margin - 1e-3, margin - 1e-4, margin + 1e-4, margin + 3e-3}) {
+    Environment env;
+    env.path = "generated";
+    Obstacle o;
+    o.name = "probe";
+    o.shape.type = ShapeType::Sphere;
+    o.shape.radius = sphere_radius;
+    // Beside the capsule's mid-point, along its local x axis.
+    o.pose.p = t.translation() + t.linear().col(0) * (capsule_radius + sphere_radius + d);
+    env.obstacles.push_back(o);
+    Checker c(robot, env);
+    const CollisionReport r = c.report(kReady);
+    EXPECT_EQ(r.env_collision, d < margin) << "d = " << d;
+    EXPECT_NEAR(min_distance(c.model, c.cd).env_distance, d, 1e-6) << "d = " << d;
+  }
+}
+
+// The fast check (bounding-volume culling, inflated shapes, early exit) must agree with the
+// exact distances: in collision exactly when some tested pair is closer than the margin.
+TEST(Collision, FastCheckAgreesWithExactDistances) {
+  const RobotModel& robot = test::panda();
+  for (const char* name : {"table", "shelf"}) {
+    Checker c(robot, env_file(name));
+    std::mt19937_64 rng(21);
+    std::uniform_real_distribution<double> u(0, 1);
+    int colliding = 0, free = 0, checked = 0;
+    for (int trial = 0; trial < 3000; ++trial) {
+      JointVector q(robot.dof);
+      for (int i = 0; i < robot.dof; ++i) q[i] = robot.q_min[i] + u(rng) * (robot.q_max[i] - robot.q_min[i]);
+      c.set(q);
+      const DistanceReport d = min_distance(c.model, c.cd);
+      if (std::abs(d.min() - c.model.margin) < 1e-6) continue;  // too close to call
+      const bool fast = in_collision(c.model, c.cd);
+      const CollisionReport r = check_collision(c.model, c.cd);
+      EXPECT_EQ(fast, d.min() < c.model.margin) << name << " trial " << trial;
+      EXPECT_EQ(r.env_collision, d.env_distance < c.model.margin) << name << " trial " << trial;
+      EXPECT_EQ(r.self_collision, d.self_distance < c.model.margin) << name << " trial " << trial;
+      (fast ? colliding : free)++;
+      ++checked;
+    }
+    // Both outcomes must be well represented for the comparison to mean something.
+    EXPECT_GT(colliding, 300) << name;
+    EXPECT_GT(free, 300) << name;
+  }
+}
+
+TEST(Collision, UnknownAllowedLinkInEnvironmentIsAnError) {
+  Environment env;
+  env.path = "custom.json";
+  Obstacle o;
+  o.name = "post";
+  o.shape.type = ShapeType::Sphere;
+  o.shape.radius = 0.1;
+  o.allowed_links = {"no_such_link"};
+  env.obstacles.push_back(o);
+  try {
+    build_collision_model(test::panda(), env);
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("custom.json"), std::string::npos);
+    EXPECT_NE(std::string(e.what()).find("no_such_link"), std::string::npos);
+  }
+}
+
+TEST(Collision, DerivedAllowedPairsAreAdjacentLinks) {
+  const RobotModel& robot = test::panda();
+  const AllowedPairsResult result = derive_allowed_pairs(robot, 2000, 1);
+  int adjacent = 0;
+  for (const LinkPairStats& p : result.pairs) {
+    const int ba = robot.links[p.link_a].body, bb = robot.links[p.link_b].body;
+    if (std::abs(ba - bb) <= 1) {
+      EXPECT_EQ(p.reason, "adjacent");
+      EXPECT_EQ(p.collisions, result.samples);  // the capsules overlap at every joint
+      ++adjacent;
+    } else {
+      EXPECT_TRUE(p.reason.empty()) << robot.links[p.link_a].name << "-" << robot.links[p.link_b].name;
+      EXPECT_LT(p.collisions, result.samples);
+    }
+  }
+  EXPECT_EQ(adjacent, 7);
+  // Every derived pair is in the committed config.
+  for (const LinkPairStats& p : result.pairs) {
+    if (!p.reason.empty()) EXPECT_TRUE(robot.is_allowed_pair(p.link_a, p.link_b));
+  }
+}
+
+}  // namespace
+}  // namespace lazyboe

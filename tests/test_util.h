@@ -1,0 +1,28 @@
+// Helpers shared by the tests: bundled files, temporary files, running the tools.
+#pragma once
+
+#include <string>
+
+#include "collision/collision_model.h"
+#include "robot/robot_model.h"
+
+namespace lazyboe::test {
+
+std::string source_path(const std::string& relative);  // inside the repository
+std::string tool_path(const std::string& tool);         // build/bin/<tool>
+
+const RobotModel& panda();  // loaded once per test binary
+
+// A fresh directory under the system temp dir, removed at exit.
+std::string temp_dir();
+std::string write_temp_file(const std::string& name, const std::string& content);
+std::string read_file(const std::string& path);
+
+struct CommandResult {
+  int exit_code = -1;
+  std::string out, err;
+};
+// Runs a shell command, capturing stdout and stderr.
+CommandResult run(const std::string& command);
+
+}  // namespace lazyboe::test

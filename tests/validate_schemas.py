@@ -1,0 +1,24 @@
+#!/usr/bin/env python3
+"""Validates the bundled JSON data files against the JSON Schemas in schemas/."""
+import json
+import pathlib
+import sys
+
+import jsonschema
+
+root = pathlib.Path(sys.argv[1])
+cases = [("schemas/robot-config.schema.json", p) for p in sorted((root / "data/robots").glob("*.json"))]
+cases += [("schemas/environment.schema.json", p) for p in sorted((root / "data/environments").glob("*.json"))]
+passed = failed = 0
+for schema_path, data_path in cases:
+    schema = json.loads((root / schema_path).read_text())
+    jsonschema.Draft202012Validator.check_schema(schema)
+    errors = list(jsonschema.Draft202012Validator(schema).iter_errors(json.loads(data_path.read_text())))
+    if errors:
+        failed += 1
+        for e in errors:
+            print(f"{data_path.relative_to(root)}: {'/'.join(map(str, e.path))}: {e.message}")
+    else:
+        passed += 1
+print(f"{passed} passed, {failed} failed")
+sys.exit(1 if failed or not cases else 0)

@@ -1,0 +1,262 @@
+// lazyboe-robot: inspect a robot description: its joints and bodies, forward kinematics,
+// inverse dynamics of logged states, collision checks, and the allowed-collision pairs.
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "collision/allowed_pairs.h"
+#include "collision/collision_model.h"
+#include "io/csv.h"
+#include "robot/dynamics.h"
+#include "tool_main.h"
+
+namespace {
+
+using namespace lazyboe;
+using nlohmann::json;
+
+JointVector parse_q(const std::string& text, const RobotModel& robot) {
+  std::vector<double> values;
+  size_t start = 0;
+  while (start <= text.size()) {  // every comma separates two values, so "1,2," has an empty third
+    const size_t comma = std::min(text.find(',', start), text.size());
+    const std::string cell = text.substr(start, comma - start);
+    start = comma + 1;
+    char* end = nullptr;
+    const double v = std::strtod(cell.c_str(), &end);
+    if (cell.empty() || end == cell.c_str() || *end != '\0') fail("--q", "not a number: '" + cell + "'");
+    if (!std::isfinite(v)) fail("--q", "values must be finite");
+    values.push_back(v);
+  }
+  if (static_cast<int>(values.size()) != robot.dof) {
+    fail("--q", "expected " + std::to_string(robot.dof) + " comma-separated joint values, got " +
+                    std::to_string(values.size()));
+  }
+  return Eigen::Map<const Eigen::VectorXd>(values.data(), robot.dof);
+}
+
+json vec_json(const Eigen::VectorXd& v) { return std::vector<double>(v.data(), v.data() + v.size()); }
+
+json friction_json(const Friction& f) {
+  switch (f.model) {
+    case FrictionModel::None: return {{"model", "none"}};
+    case FrictionModel::Sigmoid: return {{"model", "sigmoid"}, {"fi1", f.a}, {"fi2", f.b}, {"fi3", f.c}};
+    case FrictionModel::ViscousCoulomb:
+      return {{"model", "viscous_coulomb"}, {"coulomb", f.a}, {"viscous", f.b}, {"smoothing_velocity", f.c}};
+  }
+  return {};
+}
+
+std::string shape_text(const Shape& s) {
+  char buf[128];
+  switch (s.type) {
+    case ShapeType::Sphere: std::snprintf(buf, sizeof buf, "sphere r=%.4g", s.radius); break;
+    case ShapeType::Capsule: std::snprintf(buf, sizeof buf, "capsule r=%.4g l=%.4g", s.radius, s.length); break;
+    case ShapeType::Cylinder: std::snprintf(buf, sizeof buf, "cylinder r=%.4g l=%.4g", s.radius, s.length); break;
+    case ShapeType::Box: std::snprintf(buf, sizeof buf, "box %.4gx%.4gx%.4g", s.size.x(), s.size.y(), s.size.z()); break;
+  }
+  return buf;
+}
+
+int cmd_info(const RobotModel& robot, bool as_json) {
+  const CollisionModel cm = build_collision_model(robot, Environment{});
+  if (as_json) {
+    json j;
+    j["name"] = robot.name;
+    j["config"] = robot.config_path;
+    j["urdf"] = robot.urdf_path;
+    j["dof"] = robot.dof;
+    j["gravity"] = vec_json(robot.gravity);
+    j["control_rate"] = robot.control_rate;
+    for (const Joint& jt : robot.joints) {
+      j["joints"].push_back({{"name", jt.name},
+                             {"type", jt.type == JointType::Revolute ? "revolute" : "prismatic"},
+                             {"lower", jt.lower}, {"upper", jt.upper},
+                             {"max_velocity", jt.max_velocity}, {"max_acceleration", jt.max_acceleration},
+                             {"max_jerk", jt.max_jerk}, {"max_effort", jt.max_effort},
+                             {"max_torque_rate", jt.max_torque_rate}, {"friction", friction_json(jt.friction)}});
+    }
+    for (size_t b = 0; b < robot.bodies.size(); ++b) {
+      j["bodies"].push_back({{"joint", robot.joints[b].name}, {"mass", robot.bodies[b].mass},
+                             {"com", vec_json(robot.bodies[b].com)}});
+    }
+    for (const Link& l : robot.links) {
+      j["links"].push_back({{"name", l.name}, {"moved_by", l.body < 0 ? "base" : robot.joints[l.body].name}});
+    }
+    for (const CollisionBody& c : robot.collision_bodies) {
+      j["collision_bodies"].push_back({{"name", c.name}, {"link", robot.links[c.link].name},
+                                       {"shape", shape_text(c.shape)}});
+    }
+    j["collision_margin"] = robot.collision_margin;
+    for (const auto& [a, b] : robot.allowed_pairs) {
+      j["allowed_pairs"].push_back({robot.links[a].name, robot.links[b].name});
+    }
+    j["self_pairs_tested"] = cm.self_pairs.size();
+    j["ignored_links"] = robot.ignored_links;
+    std::cout << j.dump(2) << "\n";
+    return 0;
+  }
+  std::printf("robot %s\n  config %s\n  urdf   %s\n", robot.name.c_str(), robot.config_path.c_str(),
+              robot.urdf_path.c_str());
+  std::printf("%d moving joints, gravity (%g, %g, %g) m/s^2, control rate %g Hz\n\n", robot.dof,
+              robot.gravity.x(), robot.gravity.y(), robot.gravity.z(), robot.control_rate);
+  std::printf("%-14s %-9s %9s %9s %8s %8s %8s %7s %8s  %s\n", "joint", "type", "lower", "upper",
+              "vel", "acc", "jerk", "effort", "d_effort", "friction");
+  for (const Joint& j : robot.joints) {
+    std::printf("%-14s %-9s %9.4f %9.4f %8.4g %8.4g %8.4g %7.4g %8.4g  %s\n", j.name.c_str(),
+                j.type == JointType::Revolute ? "revolute" : "prismatic", j.lower, j.upper,
+                j.max_velocity, j.max_acceleration, j.max_jerk, j.max_effort, j.max_torque_rate,
+                friction_json(j.friction).dump().c_str());
+  }
+  std::printf("\n%-14s %-14s %9s\n", "link", "moved by", "mass(kg)");
+  for (const Link& l : robot.links) {
+    const bool owner = l.body >= 0 && robot.links[robot.link_index(l.name)].in_body.p.isZero() &&
+                       robot.links[robot.link_index(l.name)].in_body.R.isIdentity();
+    std::printf("%-14s %-14s", l.name.c_str(), l.body < 0 ? "base" : robot.joints[l.body].name.c_str());
+    if (owner) std::printf(" %9.4f", robot.bodies[l.body].mass);
+    std::printf("\n");
+  }
+  if (!robot.ignored_links.empty()) {
+    std::printf("ignored (behind moving side joints):");
+    for (const std::string& n : robot.ignored_links) std::printf(" %s", n.c_str());
+    std::printf("\n");
+  }
+  std::printf("\ncollision bodies (margin %g m):\n", robot.collision_margin);
+  for (const CollisionBody& c : robot.collision_bodies) {
+    std::printf("  %-16s %-14s %s\n", c.name.c_str(), robot.links[c.link].name.c_str(),
+                shape_text(c.shape).c_str());
+  }
+  std::printf("allowed-collision link pairs: %zu; body pairs tested for self-collision: %zu\n",
+              robot.allowed_pairs.size(), cm.self_pairs.size());
+  return 0;
+}
+
+int cmd_fk(const RobotModel& robot, const std::string& q_text, const std::string& link_name) {
+  const JointVector q = parse_q(q_text, robot);
+  const int link = link_name.empty() ? robot.tip_link() : robot.link_index(link_name);
+  if (link < 0) fail("--link", "unknown link '" + link_name + "' (see lazyboe-robot info)");
+  RobotData data(robot);
+  forward_kinematics(robot, data, q);
+  const Pose pose = link_pose(robot, data, link);
+  json out;
+  out["link"] = robot.links[link].name;
+  out["position"] = vec_json(pose.p);
+  out["quaternion"] = vec_json(pose.quaternion_wxyz());
+  std::cout << out.dump() << "\n";
+  return 0;
+}
+
+int cmd_torques(const RobotModel& robot, const std::string& in, const std::string& out) {
+  const int n = robot.dof;
+  std::vector<std::string> header = numbered_columns("q", n);
+  for (const char* p : {"dq", "ddq"}) {
+    for (const std::string& c : numbered_columns(p, n)) header.push_back(c);
+  }
+  const CsvTable table = read_numeric_csv(in, header);
+  RobotData data(robot);
+  CsvWriter writer(out, numbered_columns("tau", n));
+  std::vector<double> row(n);
+  for (const std::vector<double>& r : table.rows) {
+    Eigen::Map<const Eigen::VectorXd> all(r.data(), 3 * n);
+    const JointVector& tau = inverse_dynamics(robot, data, all.segment(0, n), all.segment(n, n),
+                                              all.segment(2 * n, n));
+    for (int i = 0; i < n; ++i) row[i] = tau[i];
+    writer.row(row);
+  }
+  writer.commit();
+  std::fprintf(stderr, "lazyboe-robot: wrote %zu rows to %s\n", table.rows.size(), out.c_str());
+  return 0;
+}
+
+int cmd_check(const RobotModel& robot, const std::string& env_path, const std::string& in,
+              const std::string& out) {
+  const Environment env = load_environment(env_path);
+  const CollisionModel cm = build_collision_model(robot, env);
+  const CsvTable table = read_numeric_csv(in, numbered_columns("q", robot.dof));
+  RobotData rd(robot);
+  CollisionData cd(cm);
+  CsvWriter writer(out, {"in_limits", "self_collision", "env_collision", "min_distance"});
+  long colliding = 0;
+  for (const std::vector<double>& r : table.rows) {
+    Eigen::Map<const Eigen::VectorXd> q(r.data(), robot.dof);
+    const bool in_limits =
+        (q.array() >= robot.q_min.array()).all() && (q.array() <= robot.q_max.array()).all();
+    forward_kinematics(robot, rd, q);
+    update_collision_transforms(cm, cd, rd);
+    const CollisionReport report = check_collision(cm, cd);
+    const DistanceReport dist = min_distance(cm, cd);
+    colliding += report.any();
+    writer.row({double(in_limits), double(report.self_collision), double(report.env_collision),
+                std::isfinite(dist.min()) ? dist.min() : -1.0});
+  }
+  writer.commit();
+  std::fprintf(stderr, "lazyboe-robot: %zu configurations, %ld in collision, written to %s\n",
+               table.rows.size(), colliding, out.c_str());
+  return 0;
+}
+
+int cmd_allowed_pairs(const RobotModel& robot, long samples, uint64_t seed) {
+  if (samples <= 0) fail("--samples", "must be > 0");
+  const AllowedPairsResult result = derive_allowed_pairs(robot, samples, seed);
+  json pairs = json::array();
+  std::fprintf(stderr, "%-14s %-14s %10s  %s\n", "link", "link", "collided", "allowed because");
+  for (const LinkPairStats& p : result.pairs) {
+    std::fprintf(stderr, "%-14s %-14s %9.2f%%  %s\n", robot.links[p.link_a].name.c_str(),
+                 robot.links[p.link_b].name.c_str(), 100.0 * p.collisions / samples,
+                 p.reason.empty() ? "-" : p.reason.c_str());
+    if (!p.reason.empty()) pairs.push_back({robot.links[p.link_a].name, robot.links[p.link_b].name});
+  }
+  std::cout << json{{"allowed_pairs", pairs}}.dump() << "\n";
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Inspect a robot description: joints, kinematics, dynamics, collision."};
+  app.require_subcommand(1);
+  std::string robot_path = lazyboe::default_robot_path();
+  app.add_option("--robot", robot_path, "Robot config (JSON) naming its URDF")->capture_default_str();
+
+  auto* info = app.add_subcommand("info", "Joints, limits, links and collision bodies");
+  bool info_json = false;
+  info->add_flag("--json", info_json, "Print as JSON");
+
+  auto* fk = app.add_subcommand("fk", "Pose of a link in the base frame, as JSON");
+  std::string q_text, link_name;
+  fk->add_option("--q", q_text, "Joint positions q1,...,qn")->required();
+  fk->add_option("--link", link_name, "Link name (default: the last link of the chain)");
+
+  auto* torques = app.add_subcommand("torques", "Inverse dynamics with friction for logged states");
+  std::string in_path, out_path;
+  torques->add_option("--in", in_path, "CSV with header q1..qn,dq1..dqn,ddq1..ddqn")->required();
+  torques->add_option("--out", out_path, "CSV written with header tau1..taun")->required();
+
+  auto* check = app.add_subcommand("check", "Limits and collision of configurations");
+  std::string env_path = lazyboe::default_environment_path();
+  check->add_option("--env", env_path, "Environment (JSON)")->capture_default_str();
+  check->add_option("--in", in_path, "CSV with header q1..qn")->required();
+  check->add_option("--out", out_path,
+                    "CSV written with in_limits,self_collision,env_collision,min_distance")
+      ->required();
+
+  auto* pairs = app.add_subcommand("allowed-pairs",
+                                   "Derive the allowed-collision link pairs by sampling");
+  long samples = 100000;
+  uint64_t seed = 1;
+  pairs->add_option("--samples", samples, "Random configurations to test")->capture_default_str();
+  pairs->add_option("--seed", seed, "Random seed")->capture_default_str();
+
+  lazyboe::one_line_cli_errors(app, "lazyboe-robot");
+  CLI11_PARSE(app, argc, argv);
+  return lazyboe::run_tool("lazyboe-robot", [&]() {
+    const lazyboe::RobotModel robot = lazyboe::load_robot(robot_path);
+    if (*info) return cmd_info(robot, info_json);
+    if (*fk) return cmd_fk(robot, q_text, link_name);
+    if (*torques) return cmd_torques(robot, in_path, out_path);
+    if (*check) return cmd_check(robot, env_path, in_path, out_path);
+    return cmd_allowed_pairs(robot, samples, seed);
+  });
+}
