@@ -392,6 +392,25 @@ RobotModel load_robot(const std::string& config_path) {
 
   read_config_joints(model, root);
 
+  if (root.has("controller")) {
+    const JsonField c = root.at("controller");
+    c.allow_only({"type", "description", "kp", "kd", "friction_feedforward"});
+    if (c.at("type").string() != "pd_gravity") c.at("type").fail("unknown controller (expected pd_gravity)");
+    for (auto [key, gains] : {std::pair<const char*, JointVector*>{"kp", &model.controller.kp},
+                              std::pair<const char*, JointVector*>{"kd", &model.controller.kd}}) {
+      const std::vector<JsonField> items = c.at(key).items();
+      if (static_cast<int>(items.size()) != model.dof) {
+        c.at(key).fail("expected " + std::to_string(model.dof) + " gains, one per moving joint");
+      }
+      gains->resize(model.dof);
+      for (int i = 0; i < model.dof; ++i) (*gains)[i] = items[i].positive();
+    }
+    if (c.has("friction_feedforward")) {
+      model.controller.friction_feedforward = c.at("friction_feedforward").boolean();
+    }
+    model.controller.present = true;
+  }
+
   const JsonField collision = root.at("collision");
   collision.allow_only({"margin", "allowed_pairs"});
   model.collision_margin = collision.at("margin").number_at_least(0);

@@ -66,6 +66,15 @@ struct CollisionBody {
   Pose in_link;   // shape frame in the link frame
 };
 
+// Joint-level tracking controller used to simulate the robot following velocity commands:
+//   tau = g(q) + [tau_f(v_cmd)] + kp (q_ref - q) + kd (v_cmd - dq),   q_ref = q0 + integral(v_cmd)
+// (a velocity-tracking PD law with gravity and, optionally, friction feed-forward).
+struct ControllerGains {
+  bool present = false;  // the config has a "controller" section
+  JointVector kp, kd;
+  bool friction_feedforward = true;
+};
+
 struct RobotModel {
   std::string name;
   std::string config_path;
@@ -81,6 +90,8 @@ struct RobotModel {
   std::vector<CollisionBody> collision_bodies;
   double collision_margin = 0;
   std::vector<std::pair<int, int>> allowed_pairs;  // link indices, first < second, sorted
+
+  ControllerGains controller;
 
   // Limits gathered as vectors for the validity checks.
   JointVector q_min, q_max, dq_max, ddq_max, dddq_max, tau_max, dtau_max;
