@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include <fcl/narrowphase/detail/primitive_shape_algorithm/capsule_capsule.h>
+
 #include "common/error.h"
 
 namespace lazyboe {
@@ -49,16 +51,15 @@ fcl::Transform3d to_fcl(const Pose& pose) {
   return t;
 }
 
-// Can a robot shape's bounding sphere (grown by `grow`) touch an obstacle's bounding box?
-bool sphere_may_touch_box(const Eigen::Vector3d& centre, double radius,
-                          const CollisionModel::ObstacleShape& o) {
-  const Eigen::Vector3d local = o.pose.R.transpose() * (centre - o.pose.p);
+// Can a robot shape's bounding sphere touch an obstacle's world bounding box?
+inline bool sphere_may_touch_box(const Eigen::Vector3d& centre, double radius,
+                                 const CollisionModel::ObstacleShape& o) {
   const Eigen::Vector3d outside =
-      (local.cwiseAbs() - o.half_extents).cwiseMax(Eigen::Vector3d::Zero());
+      (o.box_min - centre).cwiseMax(centre - o.box_max).cwiseMax(Eigen::Vector3d::Zero());
   return outside.squaredNorm() <= radius * radius;
 }
 
-bool spheres_may_touch(const CollisionData& data, const CollisionModel& model, int a, int b,
+inline bool spheres_may_touch(const CollisionData& data, const CollisionModel& model, int a, int b,
                        double grow) {
   const double r = model.robot[a].sphere_radius + model.robot[b].sphere_radius + grow;
   return (data.sphere_centre[a] - data.sphere_centre[b]).squaredNorm() <= r * r;
@@ -81,8 +82,21 @@ double narrow_distance(CollisionData& data, const fcl::CollisionGeometryd* g1,
   return std::max(0.0, d);
 }
 
+// Signed distance of two capsules by FCL's closed-form segment-segment routine: much cheaper
+// than the generic GJK path, and most robot shapes are capsules.
+double capsule_distance(const CollisionModel& model, const CollisionData& data, int a, int b) {
+  double dist = 0;
+  Eigen::Vector3d pa, pb;
+  fcl::detail::capsuleCapsuleDistance(*model.robot[a].capsule, data.transform[a],
+                                      *model.robot[b].capsule, data.transform[b], &dist, &pa, &pb);
+  return dist;
+}
+
 bool self_collides(const CollisionModel& model, CollisionData& data, int a, int b) {
   if (!spheres_may_touch(data, model, a, b, model.margin)) return false;
+  if (model.robot[a].capsule && model.robot[b].capsule) {
+    return capsule_distance(model, data, a, b) < model.margin;
+  }
   return narrow_collide(data, model.robot[a].inflated.get(), data.transform[a],
                         model.robot[b].exact.get(), data.transform[b]);
 }
@@ -111,6 +125,7 @@ CollisionModel build_collision_model(const RobotModel& robot, const Environment&
     s.in_body = robot.links[cb.link].in_body * cb.in_link;
     s.exact = make_geometry(cb.shape, 0);
     s.inflated = make_geometry(cb.shape, model.margin);
+    if (cb.shape.type == ShapeType::Capsule) s.capsule = static_cast<const fcl::Capsuled*>(s.exact.get());
     s.sphere_radius = bounding_radius(cb.shape);
     model.robot.push_back(s);
   }
@@ -120,7 +135,10 @@ CollisionModel build_collision_model(const RobotModel& robot, const Environment&
     s.pose = o.pose;
     s.transform = to_fcl(o.pose);
     s.geometry = make_geometry(o.shape, 0);
-    s.half_extents = bounding_half_extents(o.shape);
+    // World box around the obstacle's local bounding box (tight for axis-aligned obstacles).
+    const Eigen::Vector3d half = o.pose.R.cwiseAbs() * bounding_half_extents(o.shape);
+    s.box_min = o.pose.p - half;
+    s.box_max = o.pose.p + half;
     model.obstacles.push_back(s);
   }
   const int n = static_cast<int>(model.robot.size());
@@ -155,6 +173,9 @@ CollisionData::CollisionData(const CollisionModel& model)
     : transform(model.robot.size(), fcl::Transform3d::Identity()),
       sphere_centre(model.robot.size(), Eigen::Vector3d::Zero()) {
   request.num_max_contacts = 1;
+  // FCL's own GJK (not libccd): specialised capsule/sphere routines, no allocation per call.
+  request.gjk_solver_type = fcl::GST_LIBCCD;
+  distance_request.gjk_solver_type = fcl::GST_INDEP;
   request.enable_contact = false;
   result.clear();
 }
@@ -212,6 +233,11 @@ DistanceReport min_distance(const CollisionModel& model, CollisionData& data) {
                         model.obstacles[o].geometry.get(), model.obstacles[o].transform));
   }
   for (const auto& [a, b] : model.self_pairs) {
+    if (model.robot[a].capsule && model.robot[b].capsule) {
+      report.self_distance =
+          std::min(report.self_distance, std::max(0.0, capsule_distance(model, data, a, b)));
+      continue;
+    }
     report.self_distance =
         std::min(report.self_distance,
                  narrow_distance(data, model.robot[a].exact.get(), data.transform[a],

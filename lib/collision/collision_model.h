@@ -26,15 +26,15 @@ struct CollisionModel {
     int body = -1;  // -1: fixed to the base
     Pose in_body;
     std::shared_ptr<fcl::CollisionGeometryd> exact, inflated;
-    Eigen::Vector3d sphere_centre = Eigen::Vector3d::Zero();  // in the shape frame
-    double sphere_radius = 0;                                  // exact shape
+    const fcl::Capsuled* capsule = nullptr;  // the exact shape, when it is a capsule
+    double sphere_radius = 0;  // bounding sphere about the shape's origin (exact shape)
   };
   struct ObstacleShape {
     std::string name;
     fcl::Transform3d transform;
     Pose pose;
     std::shared_ptr<fcl::CollisionGeometryd> geometry;
-    Eigen::Vector3d half_extents;  // of the box bounding it, in its own frame
+    Eigen::Vector3d box_min, box_max;  // axis-aligned bounding box in the base frame
   };
 
   double margin = 0;

@@ -107,8 +107,7 @@ double friction_torque(const Friction& friction, double dq) {
     case FrictionModel::None:
       return 0;
     case FrictionModel::Sigmoid:
-      return friction.a / (1 + std::exp(-friction.b * (dq + friction.c))) -
-             friction.a / (1 + std::exp(-friction.b * friction.c));
+      return friction.a / (1 + std::exp(-friction.b * (dq + friction.c))) - friction.offset;
     case FrictionModel::ViscousCoulomb:
       return friction.a * std::tanh(dq / friction.c) + friction.b * dq;
   }

@@ -1,5 +1,7 @@
 #include "robot/kinematics.h"
 
+#include <cmath>
+
 namespace lazyboe {
 
 RobotData::RobotData(const RobotModel& model)
@@ -23,7 +25,14 @@ void update_joint_poses(const RobotModel& model, RobotData& data, const JointVec
   for (int i = 0; i < model.dof; ++i) {
     const Joint& j = model.joints[i];
     Pose& X = data.joint_pose[i];
-    if (j.type == JointType::Revolute) {
+    if (j.type == JointType::Revolute && j.axis_is_z) {
+      // origin.R * Rz(q): only the first two columns mix.
+      const double c = std::cos(q[i]), s = std::sin(q[i]);
+      X.R.col(0) = c * j.origin.R.col(0) + s * j.origin.R.col(1);
+      X.R.col(1) = c * j.origin.R.col(1) - s * j.origin.R.col(0);
+      X.R.col(2) = j.origin.R.col(2);
+      X.p = j.origin.p;
+    } else if (j.type == JointType::Revolute) {
       X.R.noalias() = j.origin.R * Eigen::AngleAxisd(q[i], j.axis).toRotationMatrix();
       X.p = j.origin.p;
     } else {

@@ -100,6 +100,7 @@ Friction read_friction(const JsonField& f) {
     friction.a = f.at("fi1").number();
     friction.b = f.at("fi2").number();
     friction.c = f.at("fi3").number();
+    friction.offset = friction.a / (1 + std::exp(-friction.b * friction.c));
   } else if (model == "viscous_coulomb") {
     f.allow_only({"model", "coulomb", "viscous", "smoothing_velocity"});
     friction.model = FrictionModel::ViscousCoulomb;
@@ -368,6 +369,7 @@ RobotModel load_robot(const std::string& config_path) {
         j.axis = Eigen::Vector3d(uj.axis.x, uj.axis.y, uj.axis.z);
         if (!(j.axis.norm() > 1e-9)) fail(where, "axis must not be zero");
         j.axis.normalize();
+        j.axis_is_z = (j.axis - Eigen::Vector3d::UnitZ()).norm() < 1e-15;
         if (!uj.limits) fail(where, "missing <limit>");
         j.lower = uj.limits->lower;
         j.upper = uj.limits->upper;

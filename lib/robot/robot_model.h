@@ -20,6 +20,7 @@ enum class FrictionModel { None, Sigmoid, ViscousCoulomb };
 struct Friction {
   FrictionModel model = FrictionModel::None;
   double a = 0, b = 0, c = 0;
+  double offset = 0;  // Sigmoid: a/(1+exp(-b c)), precomputed so that tau_f(0) = 0
 };
 
 struct Joint {
@@ -27,6 +28,7 @@ struct Joint {
   JointType type = JointType::Revolute;
   Pose origin;  // parent body frame -> joint frame at q = 0
   Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();  // unit, in the joint (= child body) frame
+  bool axis_is_z = true;                            // the common case, with a cheaper rotation
   double lower = 0, upper = 0;                      // position limits (rad or m)
   double max_velocity = 0, max_acceleration = 0, max_jerk = 0;
   double max_effort = 0, max_torque_rate = 0;
