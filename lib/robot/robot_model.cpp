@@ -396,16 +396,18 @@ RobotModel load_robot(const std::string& config_path) {
 
   if (root.has("controller")) {
     const JsonField c = root.at("controller");
-    c.allow_only({"type", "description", "kp", "kd", "friction_feedforward"});
-    if (c.at("type").string() != "pd_gravity") c.at("type").fail("unknown controller (expected pd_gravity)");
-    for (auto [key, gains] : {std::pair<const char*, JointVector*>{"kp", &model.controller.kp},
-                              std::pair<const char*, JointVector*>{"kd", &model.controller.kd}}) {
+    c.allow_only({"type", "description", "kv", "ka", "friction_feedforward"});
+    if (c.at("type").string() != "velocity_tracking") {
+      c.at("type").fail("unknown controller (expected velocity_tracking)");
+    }
+    for (auto [key, gains] : {std::pair<const char*, JointVector*>{"kv", &model.controller.kv},
+                              std::pair<const char*, JointVector*>{"ka", &model.controller.ka}}) {
       const std::vector<JsonField> items = c.at(key).items();
       if (static_cast<int>(items.size()) != model.dof) {
         c.at(key).fail("expected " + std::to_string(model.dof) + " gains, one per moving joint");
       }
       gains->resize(model.dof);
-      for (int i = 0; i < model.dof; ++i) (*gains)[i] = items[i].positive();
+      for (int i = 0; i < model.dof; ++i) (*gains)[i] = items[i].number_at_least(0);
     }
     if (c.has("friction_feedforward")) {
       model.controller.friction_feedforward = c.at("friction_feedforward").boolean();

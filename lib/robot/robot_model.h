@@ -68,12 +68,15 @@ struct CollisionBody {
   Pose in_link;   // shape frame in the link frame
 };
 
-// Joint-level tracking controller used to simulate the robot following velocity commands:
-//   tau = g(q) + [tau_f(v_cmd)] + kp (q_ref - q) + kd (v_cmd - dq),   q_ref = q0 + integral(v_cmd)
-// (a velocity-tracking PD law with gravity and, optionally, friction feed-forward).
+// Joint-level controller used to simulate the robot following joint-velocity commands: a
+// velocity-tracking law with model feed-forward,
+//   tau = g(q) + [tau_f(v_cmd)] + ka a_cmd + kv (v_cmd - dq).
+// There is deliberately no position loop: the end state is where the dynamics take the robot,
+// not the integral of the commands, so it depends on the start state through the dynamics.
 struct ControllerGains {
   bool present = false;  // the config has a "controller" section
-  JointVector kp, kd;
+  JointVector kv;        // velocity gain, Nm s/rad
+  JointVector ka;        // acceleration feed-forward (a nominal joint inertia), kg m^2
   bool friction_feedforward = true;
 };
 

@@ -1,0 +1,316 @@
+#include "bundle/bundle_file.h"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+
+#include "bundle/hdf5_handle.h"
+#include "common/error.h"
+
+namespace lazyboe {
+namespace {
+
+namespace ds = bundle_dataset;
+
+std::string str(uint64_t v) { return std::to_string(v); }
+
+// ---- consistency checks shared by the writer (on memory) and the reader (on the file) ----
+
+// `name` is "bundle.knot_offset" for memory, "/edges/knot_offset" for the file.
+void check_offsets(const std::string& where, const std::string& name,
+                   const std::vector<uint64_t>& offsets, uint64_t rows, const std::string& rows_name) {
+  if (offsets.empty()) return;  // sizes are checked by the caller
+  if (offsets[0] != 0) fail(where, name + ": first value " + str(offsets[0]) + ", expected 0");
+  for (size_t k = 0; k + 1 < offsets.size(); ++k)
+    if (offsets[k + 1] < offsets[k])
+      fail(where, name + ": decreases at edge " + str(k) + " (" + str(offsets[k]) + " -> " +
+                      str(offsets[k + 1]) + ")");
+  if (offsets.back() != rows)
+    fail(where, name + ": last value " + str(offsets.back()) + " does not match the " + str(rows) +
+                    " rows of " + rows_name);
+}
+
+void check_header(const std::string& where, const std::string& prefix, const BundleHeader& h) {
+  if (h.dof < 1) fail(where, prefix + "dof: " + std::to_string(h.dof) + ", expected at least 1");
+  const size_t dof = static_cast<size_t>(h.dof);
+  if (h.region_lower.size() != dof)
+    fail(where, prefix + "region_lower: " + str(h.region_lower.size()) + " values, expected dof = " +
+                    str(dof));
+  if (h.region_upper.size() != dof)
+    fail(where, prefix + "region_upper: " + str(h.region_upper.size()) + " values, expected dof = " +
+                    str(dof));
+}
+
+void check_size(const std::string& where, const std::string& field, size_t found, size_t expected,
+                const std::string& expected_text) {
+  if (found != expected)
+    fail(where, "bundle." + field + ": " + str(found) + " values, expected " + expected_text + " = " +
+                    str(expected));
+}
+
+// ---- header <-> root attributes ----
+
+void write_header(const std::string& where, hid_t file, const BundleHeader& h, uint64_t edges) {
+  using namespace h5;
+  write_attr_i64(where, file, "schema_version", kBundleSchemaVersion);
+  write_attr_string(where, file, "tool_version", h.tool_version);
+  write_attr_bool(where, file, "complete", h.complete);
+  write_attr_string(where, file, "robot_name", h.robot_name);
+  write_attr_string(where, file, "robot_config", h.robot_config);
+  write_attr_string(where, file, "robot_hash", h.robot_hash);
+  write_attr_string(where, file, "env_name", h.env_name);
+  write_attr_string(where, file, "env_file", h.env_file);
+  write_attr_string(where, file, "env_hash", h.env_hash);
+  write_attr_i64(where, file, "dof", h.dof);
+  write_attr_u64(where, file, "seed", h.seed);
+  write_attr_u64(where, file, "target_edges", h.target_edges);
+  write_attr_f64s(where, file, "region_lower", h.region_lower);
+  write_attr_f64s(where, file, "region_upper", h.region_upper);
+  write_attr_f64(where, file, "min_duration", h.min_duration);
+  write_attr_f64(where, file, "max_duration", h.max_duration);
+  write_attr_f64(where, file, "knot_interval", h.knot_interval);
+  write_attr_f64(where, file, "velocity_scale", h.velocity_scale);
+  write_attr_f64(where, file, "limit_scale", h.limit_scale);
+  write_attr_f64(where, file, "control_rate", h.control_rate);
+  write_attr_f64(where, file, "sample_interval", h.sample_interval);
+  write_attr_f64(where, file, "design_theta", h.design_theta);
+  write_attr_u64(where, file, "attempts", h.attempts);
+  write_attr_u64(where, file, "valid", h.valid);
+  std::vector<std::string> reasons;
+  std::vector<uint64_t> counts;
+  for (const auto& [reason, count] : h.rejected) {
+    reasons.push_back(reason);
+    counts.push_back(count);
+  }
+  write_attr_strings(where, file, "rejected_reasons", reasons);
+  write_attr_u64s(where, file, "rejected_counts", counts);
+  write_attr_u64(where, file, "start_resamples", h.start_resamples);
+  write_attr_string(where, file, "integrator", h.integrator);
+  write_attr_i64(where, file, "substeps", h.substeps);
+  write_attr_f64(where, file, "simulated_seconds", h.simulated_seconds);
+  write_attr_f64(where, file, "wall_seconds", h.wall_seconds);
+  write_attr_u64(where, file, "edges", edges);
+}
+
+BundleHeader read_header(const std::string& where, hid_t file, uint64_t* edges) {
+  using namespace h5;
+  BundleHeader h;
+  if (!has_attribute(file, "schema_version"))
+    fail(where, "attribute schema_version missing: not a lazyboe bundle");
+  const int64_t version = read_attr_i64(where, file, "schema_version");
+  if (version != kBundleSchemaVersion)
+    fail(where, "schema_version " + std::to_string(version) + ": written by " +
+                    (version > kBundleSchemaVersion ? "a newer" : "an older") +
+                    " lazyboe (this one reads schema version " +
+                    std::to_string(kBundleSchemaVersion) + ")");
+  h.schema_version = static_cast<int>(version);
+  h.tool_version = read_attr_string(where, file, "tool_version");
+  h.complete = read_attr_bool(where, file, "complete");
+  h.robot_name = read_attr_string(where, file, "robot_name");
+  h.robot_config = read_attr_string(where, file, "robot_config");
+  h.robot_hash = read_attr_string(where, file, "robot_hash");
+  h.env_name = read_attr_string(where, file, "env_name");
+  h.env_file = read_attr_string(where, file, "env_file");
+  h.env_hash = read_attr_string(where, file, "env_hash");
+  const int64_t dof = read_attr_i64(where, file, "dof");
+  if (dof < 1 || dof > 1000000)
+    fail(where, "attribute dof: " + std::to_string(dof) + ", expected a positive joint count");
+  h.dof = static_cast<int>(dof);
+  h.seed = read_attr_u64(where, file, "seed");
+  h.target_edges = read_attr_u64(where, file, "target_edges");
+  h.region_lower = read_attr_f64s(where, file, "region_lower");
+  h.region_upper = read_attr_f64s(where, file, "region_upper");
+  h.min_duration = read_attr_f64(where, file, "min_duration");
+  h.max_duration = read_attr_f64(where, file, "max_duration");
+  h.knot_interval = read_attr_f64(where, file, "knot_interval");
+  h.velocity_scale = read_attr_f64(where, file, "velocity_scale");
+  h.limit_scale = read_attr_f64(where, file, "limit_scale");
+  h.control_rate = read_attr_f64(where, file, "control_rate");
+  h.sample_interval = read_attr_f64(where, file, "sample_interval");
+  h.design_theta = read_attr_f64(where, file, "design_theta");
+  h.attempts = read_attr_u64(where, file, "attempts");
+  h.valid = read_attr_u64(where, file, "valid");
+  const std::vector<std::string> reasons = read_attr_strings(where, file, "rejected_reasons");
+  const std::vector<uint64_t> counts = read_attr_u64s(where, file, "rejected_counts");
+  if (reasons.size() != counts.size())
+    fail(where, "attribute rejected_counts: " + str(counts.size()) + " values, but rejected_reasons has " +
+                    str(reasons.size()));
+  for (size_t i = 0; i < reasons.size(); ++i)
+    if (!h.rejected.emplace(reasons[i], counts[i]).second)
+      fail(where, "attribute rejected_reasons: reason '" + reasons[i] + "' appears twice");
+  h.start_resamples = read_attr_u64(where, file, "start_resamples");
+  h.integrator = read_attr_string(where, file, "integrator");
+  h.substeps = static_cast<int>(read_attr_i64(where, file, "substeps"));
+  h.simulated_seconds = read_attr_f64(where, file, "simulated_seconds");
+  h.wall_seconds = read_attr_f64(where, file, "wall_seconds");
+  const uint64_t n = read_attr_u64(where, file, "edges");
+  if (edges) *edges = n;
+  check_header(where, "attribute ", h);
+  return h;
+}
+
+// Shape of a dataset, which must be `expected`; `meaning` says what the dimensions are.
+void expect_shape(const std::string& where, hid_t file, const char* name,
+                  const std::vector<uint64_t>& expected, const std::string& meaning) {
+  const std::vector<uint64_t> found = h5::dataset_shape(where, file, name);
+  if (found != expected)
+    fail(where, std::string(name) + ": shape " + h5::shape_string(found) + ", expected " +
+                    h5::shape_string(expected) + " (" + meaning + ")");
+}
+
+// Rows of a (rows x dof) dataset whose row count is free.
+uint64_t rows_of(const std::string& where, hid_t file, const char* name, uint64_t dof) {
+  const std::vector<uint64_t> found = h5::dataset_shape(where, file, name);
+  if (found.size() != 2 || found[1] != dof)
+    fail(where, std::string(name) + ": shape " + h5::shape_string(found) + ", expected rows x " +
+                    str(dof) + " (rows x dof)");
+  return found[0];
+}
+
+void fsync_path(const std::string& path, bool directory) {
+  const int fd = ::open(path.c_str(), directory ? (O_RDONLY | O_DIRECTORY) : O_RDWR);
+  if (fd < 0) fail(path, "cannot open to sync: " + std::string(std::strerror(errno)));
+  const int rc = ::fsync(fd);
+  const int err = errno;
+  ::close(fd);
+  if (rc != 0) fail(path, "cannot sync to disk: " + std::string(std::strerror(err)));
+}
+
+}  // namespace
+
+void check_bundle(const Bundle& b, const std::string& where) {
+  const BundleHeader& h = b.header;
+  if (h.schema_version != kBundleSchemaVersion)
+    fail(where, "bundle.header.schema_version: " + std::to_string(h.schema_version) +
+                    ", this lazyboe writes schema version " + std::to_string(kBundleSchemaVersion));
+  check_header(where, "bundle.header.", h);
+  const size_t n = b.duration.size();
+  const size_t dof = static_cast<size_t>(h.dof);
+  const std::string nd = "edges x dof = " + str(n) + " x " + str(dof);
+  check_size(where, "q0", b.q0.size(), n * dof, nd);
+  check_size(where, "qf", b.qf.size(), n * dof, nd);
+  check_size(where, "command_duration", b.command_duration.size(), n, "edges (duration.size())");
+  check_size(where, "attempt", b.attempt.size(), n, "edges (duration.size())");
+  check_size(where, "knot_offset", b.knot_offset.size(), n + 1, "edges + 1");
+  check_size(where, "sample_offset", b.sample_offset.size(), n + 1, "edges + 1");
+  if (b.knots.size() % dof != 0)
+    fail(where, "bundle.knots: " + str(b.knots.size()) + " values, not a multiple of dof = " + str(dof));
+  if (b.sample_q.size() % dof != 0)
+    fail(where, "bundle.sample_q: " + str(b.sample_q.size()) + " values, not a multiple of dof = " +
+                    str(dof));
+  check_size(where, "sample_dq", b.sample_dq.size(), b.sample_q.size(), "sample_q.size()");
+  check_offsets(where, "bundle.knot_offset", b.knot_offset, b.knots.size() / dof, "bundle.knots");
+  check_offsets(where, "bundle.sample_offset", b.sample_offset, b.sample_q.size() / dof,
+                "bundle.sample_q");
+}
+
+void write_bundle(const std::string& path, const Bundle& b) {
+  check_bundle(b, path);
+  const std::string tmp = path + ".tmp." + std::to_string(::getpid());
+  const uint64_t n = b.size(), dof = static_cast<uint64_t>(b.dof());
+  const uint64_t k = b.knots.size() / dof, s = b.sample_q.size() / dof;
+  try {
+    {
+      h5::File file = h5::create_file(tmp);
+      write_header(tmp, file, b.header, n);
+      h5::create_group(tmp, file, "/edges");
+      h5::create_group(tmp, file, "/controls");
+      h5::create_group(tmp, file, "/trajectory");
+      h5::write_dataset(tmp, file, ds::q0, b.q0, {n, dof});
+      h5::write_dataset(tmp, file, ds::qf, b.qf, {n, dof});
+      h5::write_dataset(tmp, file, ds::duration, b.duration, {n});
+      h5::write_dataset(tmp, file, ds::command_duration, b.command_duration, {n});
+      h5::write_dataset(tmp, file, ds::attempt, b.attempt, {n});
+      h5::write_dataset(tmp, file, ds::knot_offset, b.knot_offset, {n + 1});
+      h5::write_dataset(tmp, file, ds::sample_offset, b.sample_offset, {n + 1});
+      h5::write_dataset(tmp, file, ds::knots, b.knots, {k, dof});
+      h5::write_dataset(tmp, file, ds::sample_q, b.sample_q, {s, dof});
+      h5::write_dataset(tmp, file, ds::sample_dq, b.sample_dq, {s, dof});
+      h5::close_file(tmp, file);
+    }
+    fsync_path(tmp, false);
+    if (std::rename(tmp.c_str(), path.c_str()) != 0)
+      fail(path, "cannot rename " + tmp + " into place: " + std::strerror(errno));
+  } catch (...) {
+    ::unlink(tmp.c_str());
+    throw;
+  }
+  // Make the rename itself durable. The new file is in place already, so a failure here is
+  // not worth an error.
+  std::string dir = std::filesystem::path(path).parent_path().string();
+  try {
+    fsync_path(dir.empty() ? "." : dir, true);
+  } catch (const Error&) {
+  }
+}
+
+BundleHeader read_bundle_header(const std::string& path, uint64_t* edges) {
+  h5::File file = h5::open_file(path);
+  return read_header(path, file, edges);
+}
+
+Bundle read_bundle(const std::string& path) {
+  h5::File file = h5::open_file(path);
+  Bundle b;
+  uint64_t n = 0;
+  b.header = read_header(path, file, &n);
+  const uint64_t dof = static_cast<uint64_t>(b.header.dof);
+
+  // Every shape first (cheap), then the data.
+  expect_shape(path, file, ds::q0, {n, dof}, "edges x dof");
+  expect_shape(path, file, ds::qf, {n, dof}, "edges x dof");
+  expect_shape(path, file, ds::duration, {n}, "edges");
+  expect_shape(path, file, ds::command_duration, {n}, "edges");
+  expect_shape(path, file, ds::attempt, {n}, "edges");
+  expect_shape(path, file, ds::knot_offset, {n + 1}, "edges + 1");
+  expect_shape(path, file, ds::sample_offset, {n + 1}, "edges + 1");
+  const uint64_t k = rows_of(path, file, ds::knots, dof);
+  const uint64_t s = rows_of(path, file, ds::sample_q, dof);
+  expect_shape(path, file, ds::sample_dq, {s, dof}, "rows of /trajectory/q x dof");
+
+  b.knot_offset = h5::read_dataset<uint64_t>(path, file, ds::knot_offset, {n + 1});
+  check_offsets(path, ds::knot_offset, b.knot_offset, k, ds::knots);
+  b.sample_offset = h5::read_dataset<uint64_t>(path, file, ds::sample_offset, {n + 1});
+  check_offsets(path, ds::sample_offset, b.sample_offset, s, ds::sample_q);
+
+  b.q0 = h5::read_dataset<double>(path, file, ds::q0, {n, dof});
+  b.qf = h5::read_dataset<double>(path, file, ds::qf, {n, dof});
+  b.duration = h5::read_dataset<double>(path, file, ds::duration, {n});
+  b.command_duration = h5::read_dataset<double>(path, file, ds::command_duration, {n});
+  b.attempt = h5::read_dataset<uint64_t>(path, file, ds::attempt, {n});
+  b.knots = h5::read_dataset<double>(path, file, ds::knots, {k, dof});
+  b.sample_q = h5::read_dataset<float>(path, file, ds::sample_q, {s, dof});
+  b.sample_dq = h5::read_dataset<float>(path, file, ds::sample_dq, {s, dof});
+  return b;
+}
+
+DatasetLocation dataset_location(const std::string& where, hid_t file, const std::string& dataset) {
+  h5::Dataset dset = h5::open_dataset(where, file, dataset);
+  h5::PropList dcpl(H5Dget_create_plist(dset));
+  if (!dcpl.valid()) fail(where, dataset + ": cannot read its storage layout");
+  const H5D_layout_t layout = H5Pget_layout(dcpl);
+  if (layout < 0) fail(where, dataset + ": cannot read its storage layout");
+  DatasetLocation loc;
+  loc.contiguous = layout == H5D_CONTIGUOUS;
+  loc.bytes = H5Dget_storage_size(dset);
+  if (loc.contiguous) {
+    const haddr_t offset = H5Dget_offset(dset);
+    if (offset == HADDR_UNDEF) {
+      loc.bytes = 0;  // no storage allocated (zero-sized, or never written)
+    } else {
+      loc.file_offset = offset;
+    }
+  }
+  return loc;
+}
+
+DatasetLocation dataset_location(const std::string& path, const std::string& dataset) {
+  h5::File file = h5::open_file(path);
+  return dataset_location(path, file, dataset);
+}
+
+}  // namespace lazyboe

@@ -1,0 +1,230 @@
+#include "sim/simulator.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "common/error.h"
+
+namespace lazyboe {
+
+const char* rollout_status_name(RolloutStatus status) {
+  switch (status) {
+    case RolloutStatus::Valid: return "valid";
+    case RolloutStatus::PositionLimit: return "position_limit";
+    case RolloutStatus::VelocityLimit: return "velocity_limit";
+    case RolloutStatus::AccelerationLimit: return "acceleration_limit";
+    case RolloutStatus::JerkLimit: return "jerk_limit";
+    case RolloutStatus::TorqueLimit: return "torque_limit";
+    case RolloutStatus::TorqueRateLimit: return "torque_rate_limit";
+    case RolloutStatus::SelfCollision: return "self_collision";
+    case RolloutStatus::EnvCollision: return "env_collision";
+    case RolloutStatus::NotSettled: return "not_settled";
+  }
+  return "?";
+}
+
+namespace {
+
+// r_i: a point of a shape on body b >= i is at most
+//   sum_{k=i+1..b} |origin of joint k in body k-1| + |shape origin in body b| + shape radius
+// from joint i's origin, so turning joint i by dq moves it at most r_i |dq| (a prismatic
+// joint moves everything by exactly |dq|). Summed over joints, this bounds the path length of
+// every point of the robot for a small joint motion.
+JointVector lever_arms(const RobotModel& robot, const CollisionModel& collision) {
+  const int n = robot.dof;
+  JointVector r = JointVector::Zero(n);
+  for (int i = 0; i < n; ++i) {
+    if (robot.joints[i].type == JointType::Prismatic) {
+      r[i] = 1.0;
+      continue;
+    }
+    for (const CollisionModel::RobotShape& s : collision.robot) {
+      if (s.body < i) continue;
+      double reach = s.in_body.p.norm() + s.sphere_radius;
+      for (int k = i + 1; k <= s.body; ++k) reach += robot.joints[k].origin.p.norm();
+      r[i] = std::max(r[i], reach);
+    }
+  }
+  return r;
+}
+
+bool within(const JointVector& value, const JointVector& bound) {
+  return (value.array().abs() <= bound.array()).all();
+}
+
+}  // namespace
+
+Simulator::Simulator(const RobotModel& robot_model, const CollisionModel& collision_model,
+                     SimulationOptions opts)
+    : robot(robot_model),
+      collision(collision_model),
+      options(opts),
+      dt(1.0 / robot_model.control_rate),
+      lever_arm(lever_arms(robot_model, collision_model)) {
+  if (!robot.controller.present) {
+    fail(robot.config_path, "controller: missing (the simulator needs the joint controller gains)");
+  }
+  if (options.substeps < 1) fail("substeps", "must be >= 1");
+}
+
+SimulatorWorkspace::SimulatorWorkspace(const Simulator& sim)
+    : robot(sim.robot), collision(sim.collision) {}
+
+RolloutStatus check_state(const Simulator& sim, SimulatorWorkspace& ws, const JointVectorRef& q) {
+  const RobotModel& robot = sim.robot;
+  if (!((q.array() > robot.q_min.array()).all() && (q.array() < robot.q_max.array()).all())) {
+    return RolloutStatus::PositionLimit;
+  }
+  forward_kinematics(robot, ws.robot, q);
+  update_collision_transforms(sim.collision, ws.collision, ws.robot);
+  const CollisionReport report = check_collision(sim.collision, ws.collision);
+  if (report.env_collision) return RolloutStatus::EnvCollision;
+  if (report.self_collision) return RolloutStatus::SelfCollision;
+  return RolloutStatus::Valid;
+}
+
+namespace {
+
+RolloutStatus collision_status(const Simulator& sim, SimulatorWorkspace& ws, const JointVector& q,
+                               int& checks) {
+  ++checks;
+  forward_kinematics(sim.robot, ws.robot, q);
+  update_collision_transforms(sim.collision, ws.collision, ws.robot);
+  if (!in_collision(sim.collision, ws.collision)) return RolloutStatus::Valid;
+  const CollisionReport report = check_collision(sim.collision, ws.collision);
+  return report.env_collision ? RolloutStatus::EnvCollision : RolloutStatus::SelfCollision;
+}
+
+void push_sample(const TrajectorySamples& samples, const JointVector& q, const JointVector& dq) {
+  if (!samples.q) return;
+  for (int i = 0; i < q.size(); ++i) {
+    samples.q->push_back(static_cast<float>(q[i]));
+    samples.dq->push_back(static_cast<float>(dq[i]));
+  }
+}
+
+}  // namespace
+
+RolloutResult simulate(const Simulator& sim, SimulatorWorkspace& ws, const JointVectorRef& q0_in,
+                       const CommandProfile& profile, TrajectorySamples samples) {
+  const RobotModel& robot = sim.robot;
+  const ControllerGains& gains = robot.controller;
+  const int n = robot.dof;
+  const double dt = sim.dt, h = dt / sim.options.substeps;
+  const double margin = sim.collision.margin;
+  RobotData& rd = ws.robot;
+
+  RolloutResult result;
+  const JointVector q0 = q0_in;
+  JointVector q = q0, dq = JointVector::Zero(n), q_prev = q0;
+  JointVector v_cmd(n), a_cmd(n), offset(n), tau(n);
+  // At rest before the edge, the controller holds the arm against gravity.
+  JointVector tau_prev = gravity_torques(robot, rd, q0);
+  JointVector ddq_prev = JointVector::Zero(n);
+  JointVector k1q(n), k1v(n), k2q(n), k2v(n), k3q(n), k3v(n), k4q(n), k4v(n), ddq(n);
+  const JointVector tau_rate_max = robot.dtau_max * dt;
+  const JointVector ddq_step_max = robot.dddq_max * dt;
+
+  auto finish = [&](RolloutStatus status, int tick) {
+    result.status = status;
+    result.qf = q;
+    result.ticks = tick;
+    result.duration = tick * dt;
+    return result;
+  };
+
+  RolloutStatus start = check_state(sim, ws, q0);
+  ++result.collision_checks;
+  if (start != RolloutStatus::Valid) return finish(start, 0);
+  push_sample(samples, q, dq);
+
+  const int max_ticks = static_cast<int>(std::ceil((profile.duration + sim.options.max_settle_time) / dt));
+  double moved = 0;  // bound on any point's path length since the last collision check
+  for (int tick = 0; tick < max_ticks; ++tick) {
+    const double t = tick * dt;
+    evaluate_command(profile, t, v_cmd.data(), a_cmd.data(), offset.data());
+
+    // Joint controller: gravity, friction and inertia feed-forward, P on the velocity error.
+    tau = gravity_torques(robot, rd, q);
+    for (int i = 0; i < n; ++i) {
+      tau[i] += gains.ka[i] * a_cmd[i] + gains.kv[i] * (v_cmd[i] - dq[i]);
+      if (gains.friction_feedforward) tau[i] += friction_torque(robot.joints[i].friction, v_cmd[i]);
+    }
+    if (!within(tau, robot.tau_max)) return finish(RolloutStatus::TorqueLimit, tick);
+    if (!within(tau - tau_prev, tau_rate_max)) return finish(RolloutStatus::TorqueRateLimit, tick);
+    tau_prev = tau;
+
+    // At rest after the command: stop once the next edge could start without a jump in
+    // velocity, acceleration (jerk) or torque (the next edge starts from holding torque g(q)).
+    if (t >= profile.duration && (dq.array().abs() <= sim.options.settle_velocity).all()) {
+      const JointVector& hold = gravity_torques(robot, rd, q);
+      if (within(ddq_prev, ddq_step_max) && within(tau - hold, tau_rate_max)) {
+        if (moved > 0) {
+          const RolloutStatus c = collision_status(sim, ws, q, result.collision_checks);
+          if (c != RolloutStatus::Valid) return finish(c, tick);
+        }
+        if (samples.q && (sim.options.sample_every <= 0 || tick % sim.options.sample_every != 0)) {
+          push_sample(samples, q, dq);
+        }
+        return finish(RolloutStatus::Valid, tick);
+      }
+    }
+
+    // RK4 over one control period with the torque held.
+    q_prev = q;
+    for (int sub = 0; sub < sim.options.substeps; ++sub) {
+      if (sim.options.integrator == Integrator::SemiImplicitEuler) {
+        k1v = forward_dynamics(robot, rd, q, dq, tau);
+        if (sub == 0) ddq = k1v;
+        dq += h * k1v;
+        q += h * dq;
+        continue;
+      }
+      k1q = dq;
+      k1v = forward_dynamics(robot, rd, q, dq, tau);
+      if (sub == 0) ddq = k1v;
+      k2q = dq + 0.5 * h * k1v;
+      k2v = forward_dynamics(robot, rd, q + 0.5 * h * k1q, k2q, tau);
+      k3q = dq + 0.5 * h * k2v;
+      k3v = forward_dynamics(robot, rd, q + 0.5 * h * k2q, k3q, tau);
+      k4q = dq + h * k3v;
+      k4v = forward_dynamics(robot, rd, q + h * k3q, k4q, tau);
+      q += (h / 6) * (k1q + 2 * k2q + 2 * k3q + k4q);
+      dq += (h / 6) * (k1v + 2 * k2v + 2 * k3v + k4v);
+    }
+    if (!within(ddq, robot.ddq_max)) return finish(RolloutStatus::AccelerationLimit, tick);
+    if (!within(ddq - ddq_prev, ddq_step_max)) return finish(RolloutStatus::JerkLimit, tick);
+    ddq_prev = ddq;
+    if (!((q.array() > robot.q_min.array()).all() && (q.array() < robot.q_max.array()).all())) {
+      return finish(RolloutStatus::PositionLimit, tick + 1);
+    }
+    if (!within(dq, robot.dq_max)) return finish(RolloutStatus::VelocityLimit, tick + 1);
+
+    // Collision checks spaced so that no point moves more than the margin between two.
+    const double step = sim.lever_arm.dot((q - q_prev).cwiseAbs());
+    if (moved + step > margin) {
+      if (moved > 0) {
+        const RolloutStatus c = collision_status(sim, ws, q_prev, result.collision_checks);
+        if (c != RolloutStatus::Valid) return finish(c, tick);
+      }
+      moved = step;
+      if (step > margin) {  // one tick moved too far: check in between as well
+        const int pieces = static_cast<int>(std::ceil(step / margin));
+        for (int j = 1; j < pieces; ++j) {
+          k1q = q_prev + (static_cast<double>(j) / pieces) * (q - q_prev);
+          const RolloutStatus c = collision_status(sim, ws, k1q, result.collision_checks);
+          if (c != RolloutStatus::Valid) return finish(c, tick);
+        }
+        moved = step / pieces;
+      }
+    } else {
+      moved += step;
+    }
+    if (sim.options.sample_every > 0 && (tick + 1) % sim.options.sample_every == 0) {
+      push_sample(samples, q, dq);
+    }
+  }
+  return finish(RolloutStatus::NotSettled, max_ticks);
+}
+
+}  // namespace lazyboe

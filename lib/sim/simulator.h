@@ -1,0 +1,87 @@
+// The forward model f of the paper: a rollout of the robot's dynamics following a joint-velocity
+// command profile, tracked by the joint controller of the robot config, integrated with RK4 at
+// the control rate (torques held between control ticks), and validated at every tick:
+// position, velocity, acceleration, torque limits; continuity (jerk, torque rate, also at the
+// start and end, where the robot is at rest); self- and environment collision, checked densely
+// enough that no point of the robot moves more than the collision margin between two checks.
+//
+// Simulator is built once and read-only (shared by threads); each thread owns a
+// SimulatorWorkspace. Every planner and tool uses this one simulator.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "collision/collision_model.h"
+#include "robot/dynamics.h"
+#include "sim/command_profile.h"
+
+namespace lazyboe {
+
+enum class RolloutStatus : uint8_t {
+  Valid,
+  PositionLimit,
+  VelocityLimit,
+  AccelerationLimit,
+  JerkLimit,
+  TorqueLimit,
+  TorqueRateLimit,
+  SelfCollision,
+  EnvCollision,
+  NotSettled,
+};
+constexpr int kRolloutStatusCount = 10;
+const char* rollout_status_name(RolloutStatus status);
+
+// RK4: 4th order, 4 forward-dynamics evaluations per step. SemiImplicitEuler: 1st order and
+// symplectic (velocity first, then position with the new velocity), 1 evaluation per step.
+enum class Integrator : uint8_t { RK4, SemiImplicitEuler };
+
+struct SimulationOptions {
+  Integrator integrator = Integrator::RK4;
+  int substeps = 1;               // integration steps per control period
+  double settle_velocity = 1e-3;  // at rest when every |dq| is below this (rad/s)
+  double max_settle_time = 1.0;   // after the command ends, s
+  int sample_every = 20;          // control ticks between stored trajectory samples (0: none)
+};
+
+struct Simulator {
+  Simulator(const RobotModel& robot, const CollisionModel& collision, SimulationOptions options);
+
+  const RobotModel& robot;
+  const CollisionModel& collision;
+  SimulationOptions options;
+  double dt;              // control period, s
+  JointVector lever_arm;  // per joint: bound on any robot point's motion per unit joint motion
+};
+
+struct SimulatorWorkspace {
+  explicit SimulatorWorkspace(const Simulator& sim);
+  RobotData robot;
+  CollisionData collision;
+};
+
+struct RolloutResult {
+  RolloutStatus status = RolloutStatus::Valid;
+  JointVector qf;             // final state (at rest when valid)
+  double duration = 0;        // simulated time, s
+  int ticks = 0;              // control ticks simulated
+  int collision_checks = 0;
+  bool valid() const { return status == RolloutStatus::Valid; }
+};
+
+// Optional output of a rollout: states every `sample_every` ticks, plus the final state.
+struct TrajectorySamples {
+  std::vector<float>* q = nullptr;
+  std::vector<float>* dq = nullptr;
+};
+
+// Simulates from rest at q0. Stops at the first violation. Allocates nothing when the sample
+// vectors have capacity.
+RolloutResult simulate(const Simulator& sim, SimulatorWorkspace& ws, const JointVectorRef& q0,
+                       const CommandProfile& profile, TrajectorySamples samples = {});
+
+// Limits and collision of a single configuration at rest (for start states and queries).
+RolloutStatus check_state(const Simulator& sim, SimulatorWorkspace& ws, const JointVectorRef& q);
+
+}  // namespace lazyboe

@@ -1,0 +1,518 @@
+// The edge bundle's HDF5 file: round trips, contiguous storage for memory-mapping, crash-safe
+// rewrites and one-line errors for every kind of bad file.
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cstring>
+#include <filesystem>
+#include <functional>
+#include <random>
+#include <thread>
+
+#include "bundle/bundle_file.h"
+#include "bundle/hdf5_handle.h"
+#include "common/error.h"
+#include "common/hash.h"
+#include "test_util.h"
+
+namespace lazyboe {
+namespace {
+
+namespace fs = std::filesystem;
+using test::temp_dir;
+
+// A bundle of n edges with random contents, ragged knots (0..5 per edge) and samples (1..12).
+Bundle random_bundle(size_t n, int dof, uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(-3.0, 3.0);
+  std::uniform_int_distribution<int> knots_per_edge(0, 5), samples_per_edge(1, 12);
+  Bundle b;
+  BundleHeader& h = b.header;
+  h.tool_version = "0.1.0";
+  h.complete = true;
+  h.robot_name = "panda";
+  h.robot_config = "data/robots/panda.json";
+  h.robot_hash = fnv1a64_hex("robot" + std::to_string(seed));
+  h.env_name = "table \xc3\xa9t\xc3\xa9";  // UTF-8
+  h.env_file = "data/environments/table.json";
+  h.env_hash = fnv1a64_hex("env");
+  h.dof = dof;
+  h.seed = seed;
+  h.target_edges = 0xfedcba9876543210ull;
+  for (int j = 0; j < dof; ++j) {
+    h.region_lower.push_back(u(rng) - 3);
+    h.region_upper.push_back(u(rng) + 3);
+  }
+  h.min_duration = 0.2;
+  h.max_duration = 1.7;
+  h.knot_interval = 0.1;
+  h.velocity_scale = 0.55;
+  h.limit_scale = 0.8;
+  h.control_rate = 1000;
+  h.sample_interval = 0.01;
+  h.design_theta = 0.3;
+  h.attempts = 123456789012ull;
+  h.valid = n;
+  h.rejected = {{"collision", 17}, {"joint_limit", 4}, {"torque_limit", 0}, {"unstable settle", 99}};
+  h.start_resamples = 77;
+  h.integrator = "rk4";
+  h.substeps = 3;
+  h.simulated_seconds = 1234.5678;
+  h.wall_seconds = 0.1 + 0.2;
+
+  b.knot_offset.push_back(0);
+  b.sample_offset.push_back(0);
+  for (size_t k = 0; k < n; ++k) {
+    for (int j = 0; j < dof; ++j) {
+      b.q0.push_back(u(rng));
+      b.qf.push_back(u(rng));
+    }
+    b.duration.push_back(u(rng) + 4);
+    b.command_duration.push_back(u(rng) + 3);
+    b.attempt.push_back(rng());
+    const int nk = knots_per_edge(rng), ns = samples_per_edge(rng);
+    for (int r = 0; r < nk * dof; ++r) b.knots.push_back(u(rng));
+    for (int r = 0; r < ns * dof; ++r) {
+      b.sample_q.push_back(static_cast<float>(u(rng)));
+      b.sample_dq.push_back(static_cast<float>(u(rng)));
+    }
+    b.knot_offset.push_back(b.knot_offset.back() + nk);
+    b.sample_offset.push_back(b.sample_offset.back() + ns);
+  }
+  if (!b.knots.empty()) b.knots[0] = -0.0;  // signs of zero survive too
+  return b;
+}
+
+Bundle empty_bundle(int dof) {
+  Bundle b;
+  b.header.dof = dof;
+  b.header.region_lower.assign(dof, -1.0);
+  b.header.region_upper.assign(dof, 1.0);
+  b.knot_offset = {0};
+  b.sample_offset = {0};
+  return b;
+}
+
+template <class T>
+bool same_bytes(const std::vector<T>& a, const std::vector<T>& b) {
+  return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
+}
+
+bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+void expect_same_header(const BundleHeader& a, const BundleHeader& b) {
+  EXPECT_EQ(a.schema_version, b.schema_version);
+  EXPECT_EQ(a.tool_version, b.tool_version);
+  EXPECT_EQ(a.complete, b.complete);
+  EXPECT_EQ(a.robot_name, b.robot_name);
+  EXPECT_EQ(a.robot_config, b.robot_config);
+  EXPECT_EQ(a.robot_hash, b.robot_hash);
+  EXPECT_EQ(a.env_name, b.env_name);
+  EXPECT_EQ(a.env_file, b.env_file);
+  EXPECT_EQ(a.env_hash, b.env_hash);
+  EXPECT_EQ(a.dof, b.dof);
+  EXPECT_EQ(a.seed, b.seed);
+  EXPECT_EQ(a.target_edges, b.target_edges);
+  EXPECT_TRUE(same_bytes(a.region_lower, b.region_lower));
+  EXPECT_TRUE(same_bytes(a.region_upper, b.region_upper));
+  EXPECT_TRUE(same_bits(a.min_duration, b.min_duration));
+  EXPECT_TRUE(same_bits(a.max_duration, b.max_duration));
+  EXPECT_TRUE(same_bits(a.knot_interval, b.knot_interval));
+  EXPECT_TRUE(same_bits(a.velocity_scale, b.velocity_scale));
+  EXPECT_TRUE(same_bits(a.limit_scale, b.limit_scale));
+  EXPECT_TRUE(same_bits(a.control_rate, b.control_rate));
+  EXPECT_TRUE(same_bits(a.sample_interval, b.sample_interval));
+  EXPECT_TRUE(same_bits(a.design_theta, b.design_theta));
+  EXPECT_EQ(a.attempts, b.attempts);
+  EXPECT_EQ(a.valid, b.valid);
+  EXPECT_EQ(a.rejected, b.rejected);
+  EXPECT_EQ(a.start_resamples, b.start_resamples);
+  EXPECT_EQ(a.integrator, b.integrator);
+  EXPECT_EQ(a.substeps, b.substeps);
+  EXPECT_TRUE(same_bits(a.simulated_seconds, b.simulated_seconds));
+  EXPECT_TRUE(same_bits(a.wall_seconds, b.wall_seconds));
+}
+
+void expect_same(const Bundle& a, const Bundle& b) {
+  expect_same_header(a.header, b.header);
+  EXPECT_TRUE(same_bytes(a.q0, b.q0));
+  EXPECT_TRUE(same_bytes(a.qf, b.qf));
+  EXPECT_TRUE(same_bytes(a.duration, b.duration));
+  EXPECT_TRUE(same_bytes(a.command_duration, b.command_duration));
+  EXPECT_TRUE(same_bytes(a.attempt, b.attempt));
+  EXPECT_TRUE(same_bytes(a.knot_offset, b.knot_offset));
+  EXPECT_TRUE(same_bytes(a.knots, b.knots));
+  EXPECT_TRUE(same_bytes(a.sample_offset, b.sample_offset));
+  EXPECT_TRUE(same_bytes(a.sample_q, b.sample_q));
+  EXPECT_TRUE(same_bytes(a.sample_dq, b.sample_dq));
+}
+
+// The message of the Error f throws ("" and a test failure when it throws none).
+std::string error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const Error& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "expected an Error";
+  return "";
+}
+
+// One line, starting with the file, mentioning every one of `parts`.
+void expect_error(const std::string& message, const std::string& file,
+                  std::initializer_list<std::string> parts) {
+  EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+  EXPECT_EQ(message.rfind(file + ": ", 0), 0u) << message;
+  for (const std::string& part : parts) EXPECT_NE(message.find(part), std::string::npos) << message;
+}
+
+std::string fresh_path(const std::string& name) {
+  const std::string dir = temp_dir() + "/" + name;
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir + "/bundle.h5";
+}
+
+// Files in the directory of `path` other than `path` itself (leftover temporaries).
+std::vector<std::string> others_in_dir(const std::string& path) {
+  std::vector<std::string> out;
+  for (const auto& e : fs::directory_iterator(fs::path(path).parent_path()))
+    if (e.path() != fs::path(path)) out.push_back(e.path().filename().string());
+  return out;
+}
+
+std::string file_bytes(const std::string& path) { return test::read_file(path); }
+
+// ---- hashes -------------------------------------------------------------------------------
+
+TEST(Hash, Fnv1a64KnownValues) {
+  EXPECT_EQ(fnv1a64_hex(""), "cbf29ce484222325");
+  EXPECT_EQ(fnv1a64_hex("a"), "af63dc4c8601ec8c");
+  EXPECT_EQ(fnv1a64_hex("foobar"), "85944171f73967e8");
+}
+
+TEST(Hash, FilesAreLengthPrefixed) {
+  const std::string a = test::write_temp_file("hash/a.txt", "ab");
+  const std::string b = test::write_temp_file("hash/b.txt", "c");
+  const std::string c = test::write_temp_file("hash/c.txt", "a");
+  const std::string d = test::write_temp_file("hash/d.txt", "bc");
+  const std::string len2("\x02\0\0\0\0\0\0\0", 8), len1("\x01\0\0\0\0\0\0\0", 8);
+  EXPECT_EQ(hash_files({a, b}), fnv1a64_hex(len2 + "ab" + len1 + "c"));
+  EXPECT_NE(hash_files({a, b}), hash_files({c, d}));  // same concatenation, other split
+  EXPECT_EQ(hash_files({}), fnv1a64_hex(""));
+  const std::string missing = temp_dir() + "/hash/missing.urdf";
+  expect_error(error_of([&] { hash_files({a, missing}); }), missing, {"cannot read"});
+}
+
+// ---- round trips --------------------------------------------------------------------------
+
+TEST(BundleFile, RandomBundleRoundTripIsBitIdentical) {
+  const Bundle b = random_bundle(50, 7, 42);
+  ASSERT_GT(b.knots.size(), 0u);
+  ASSERT_NE(b.knot_offset.back(), b.sample_offset.back());
+  const std::string path = fresh_path("roundtrip");
+  write_bundle(path, b);
+  const Bundle r = read_bundle(path);
+  expect_same(b, r);
+  EXPECT_EQ(r.size(), 50u);
+  EXPECT_TRUE(std::signbit(r.knots[0]));
+
+  uint64_t edges = 0;
+  const BundleHeader h = read_bundle_header(path, &edges);
+  expect_same_header(b.header, h);
+  EXPECT_EQ(edges, 50u);
+  EXPECT_TRUE(others_in_dir(path).empty());
+}
+
+TEST(BundleFile, EmptyBundleRoundTrip) {
+  const Bundle b = empty_bundle(7);
+  const std::string path = fresh_path("empty");
+  write_bundle(path, b);
+  const Bundle r = read_bundle(path);
+  expect_same(b, r);
+  EXPECT_EQ(r.size(), 0u);
+  EXPECT_FALSE(r.header.complete);
+  EXPECT_TRUE(r.header.rejected.empty());
+  for (const char* name : {bundle_dataset::q0, bundle_dataset::knots, bundle_dataset::sample_dq}) {
+    const DatasetLocation loc = dataset_location(path, name);
+    EXPECT_TRUE(loc.contiguous) << name;
+    EXPECT_EQ(loc.bytes, 0u) << name;
+  }
+}
+
+TEST(BundleFile, SameBundleGivesSameBytes) {
+  const Bundle b = random_bundle(20, 7, 5);
+  const std::string p1 = fresh_path("same1"), p2 = fresh_path("same2");
+  write_bundle(p1, b);
+  write_bundle(p2, b);
+  EXPECT_EQ(file_bytes(p1), file_bytes(p2));
+}
+
+TEST(BundleFile, RewriteReplacesTheFile) {
+  const std::string path = fresh_path("rewrite");
+  write_bundle(path, random_bundle(10, 7, 1));
+  const Bundle b = random_bundle(30, 7, 2);
+  write_bundle(path, b);
+  expect_same(b, read_bundle(path));
+  EXPECT_TRUE(others_in_dir(path).empty());
+}
+
+// ---- memory-mapping -----------------------------------------------------------------------
+
+template <class T>
+void expect_mapped(const std::string& path, int fd, const char* name, const std::vector<T>& data) {
+  const DatasetLocation loc = dataset_location(path, name);
+  EXPECT_TRUE(loc.contiguous) << name;
+  ASSERT_EQ(loc.bytes, data.size() * sizeof(T)) << name;
+  std::vector<T> raw(data.size());
+  ASSERT_EQ(::pread(fd, raw.data(), loc.bytes, static_cast<off_t>(loc.file_offset)),
+            static_cast<ssize_t>(loc.bytes))
+      << name;
+  EXPECT_TRUE(same_bytes(raw, data)) << name;
+}
+
+TEST(BundleFile, DatasetsAreContiguousAndMappable) {
+  const Bundle b = random_bundle(50, 7, 7);
+  const std::string path = fresh_path("mapped");
+  write_bundle(path, b);
+  const int fd = ::open(path.c_str(), O_RDONLY);
+  ASSERT_GE(fd, 0);
+  namespace ds = bundle_dataset;
+  expect_mapped(path, fd, ds::q0, b.q0);
+  expect_mapped(path, fd, ds::qf, b.qf);
+  expect_mapped(path, fd, ds::duration, b.duration);
+  expect_mapped(path, fd, ds::command_duration, b.command_duration);
+  expect_mapped(path, fd, ds::attempt, b.attempt);
+  expect_mapped(path, fd, ds::knot_offset, b.knot_offset);
+  expect_mapped(path, fd, ds::sample_offset, b.sample_offset);
+  expect_mapped(path, fd, ds::knots, b.knots);
+  expect_mapped(path, fd, ds::sample_q, b.sample_q);
+  expect_mapped(path, fd, ds::sample_dq, b.sample_dq);
+  ::close(fd);
+  expect_error(error_of([&] { dataset_location(path, "/edges/nope"); }), path,
+               {"/edges/nope", "missing"});
+}
+
+// ---- crash safety -------------------------------------------------------------------------
+
+TEST(BundleFile, FailedWriteKeepsTheOldFile) {
+  const std::string path = fresh_path("failed");
+  const Bundle old = random_bundle(25, 7, 3);
+  write_bundle(path, old);
+
+  Bundle bad = random_bundle(40, 7, 4);
+  bad.qf.pop_back();
+  expect_error(error_of([&] { write_bundle(path, bad); }), path, {"bundle.qf", "279", "280"});
+  expect_same(old, read_bundle(path));
+  EXPECT_TRUE(others_in_dir(path).empty());
+
+  // A failure after the temporary file is under way: something is in the way of its name.
+  const std::string tmp = path + ".tmp." + std::to_string(::getpid());
+  fs::create_directory(tmp);
+  expect_error(error_of([&] { write_bundle(path, random_bundle(40, 7, 4)); }), tmp, {"cannot create"});
+  expect_same(old, read_bundle(path));
+  EXPECT_TRUE(fs::is_directory(tmp));  // not ours to remove
+  fs::remove(tmp);
+  EXPECT_TRUE(others_in_dir(path).empty());
+}
+
+TEST(BundleFile, InconsistentBundlesAreRefusedNamingTheField) {
+  const std::string path = fresh_path("inconsistent");
+  const Bundle good = random_bundle(10, 7, 9);
+  struct Case {
+    std::function<void(Bundle&)> spoil;
+    std::vector<std::string> parts;
+  };
+  const std::vector<Case> cases = {
+      {[](Bundle& b) { b.header.dof = 0; }, {"bundle.header.dof"}},
+      {[](Bundle& b) { b.header.schema_version = 2; }, {"bundle.header.schema_version"}},
+      {[](Bundle& b) { b.header.region_upper.pop_back(); }, {"bundle.header.region_upper", "6"}},
+      {[](Bundle& b) { b.q0.push_back(1); }, {"bundle.q0", "71", "70"}},
+      {[](Bundle& b) { b.command_duration.pop_back(); }, {"bundle.command_duration"}},
+      {[](Bundle& b) { b.attempt.clear(); }, {"bundle.attempt"}},
+      {[](Bundle& b) { b.knot_offset.pop_back(); }, {"bundle.knot_offset", "edges + 1"}},
+      {[](Bundle& b) { b.sample_offset[0] = 1; }, {"bundle.sample_offset", "first value"}},
+      {[](Bundle& b) { b.knot_offset.back() += 1; }, {"bundle.knot_offset", "last value", "bundle.knots"}},
+      {[](Bundle& b) { std::swap(b.sample_offset[3], b.sample_offset[4]); },
+       {"bundle.sample_offset", "decreases at edge 3"}},
+      {[](Bundle& b) { b.knots.pop_back(); }, {"bundle.knots", "multiple of dof"}},
+      {[](Bundle& b) { b.sample_dq.pop_back(); }, {"bundle.sample_dq"}},
+  };
+  for (const Case& c : cases) {
+    Bundle b = good;
+    c.spoil(b);
+    const std::string message = error_of([&] { write_bundle(path, b); });
+    expect_error(message, path, {});
+    for (const std::string& part : c.parts) EXPECT_NE(message.find(part), std::string::npos) << message;
+    EXPECT_FALSE(fs::exists(path));
+    EXPECT_TRUE(others_in_dir(path).empty());
+  }
+}
+
+// A writer killed at arbitrary moments leaves either the old or the new file, never a broken one.
+TEST(BundleFile, KilledWriterLeavesACompleteFile) {
+  const std::string path = fresh_path("killed");
+  const Bundle a = random_bundle(3000, 7, 11), b = random_bundle(2000, 7, 12);
+  // Kill after 0.25 to 3 times the time one write takes here, so some kills land mid-write and
+  // some after the new file is in place, on fast and slow disks alike.
+  const auto start = std::chrono::steady_clock::now();
+  write_bundle(path, b);
+  const auto one_write = std::chrono::steady_clock::now() - start;
+  write_bundle(path, a);
+  int saw_b = 0;
+  for (int round = 0; round < 12; ++round) {
+    const pid_t child = ::fork();
+    ASSERT_GE(child, 0);
+    if (child == 0) {
+      try {
+        for (int i = 0;; ++i) write_bundle(path, i % 2 ? a : b);
+      } catch (...) {
+        ::_exit(1);
+      }
+    }
+    std::this_thread::sleep_for(one_write * (round + 1) / 4);
+    ::kill(child, SIGKILL);
+    int status = 0;
+    ::waitpid(child, &status, 0);
+    ASSERT_TRUE(WIFSIGNALED(status)) << "the writer failed on its own";
+    const Bundle r = read_bundle(path);
+    ASSERT_TRUE(r.header.seed == a.header.seed || r.header.seed == b.header.seed);
+    if (r.header.seed == a.header.seed) {
+      expect_same(a, r);
+    } else {
+      expect_same(b, r);
+      ++saw_b;
+    }
+    // A killed writer cannot remove its temporary file; only such files may be left.
+    for (const std::string& name : others_in_dir(path)) {
+      EXPECT_EQ(name.rfind("bundle.h5.tmp.", 0), 0u) << name;
+      fs::remove(fs::path(path).parent_path() / name);
+    }
+  }
+  EXPECT_GT(saw_b, 0) << "the writer never got a file in place; kill later";
+}
+
+// ---- bad files ----------------------------------------------------------------------------
+
+TEST(BundleFile, MissingFile) {
+  const std::string path = temp_dir() + "/no/such/bundle.h5";
+  expect_error(error_of([&] { read_bundle(path); }), path, {"No such file"});
+  expect_error(error_of([&] { read_bundle_header(path); }), path, {"No such file"});
+}
+
+TEST(BundleFile, NotAnHdf5File) {
+  const std::string path = test::write_temp_file("text.h5", "q0,qf\n1,2\n");
+  expect_error(error_of([&] { read_bundle(path); }), path, {"not an HDF5 file"});
+}
+
+TEST(BundleFile, OtherSchemaVersions) {
+  for (int version : {2, 0}) {
+    const std::string path = fresh_path("version" + std::to_string(version));
+    {
+      h5::File file(H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT));
+      ASSERT_TRUE(file.valid());
+      h5::Dataspace space(H5Screate(H5S_SCALAR));
+      h5::Attribute attr(H5Acreate2(file, "schema_version", H5T_STD_I32LE, space, H5P_DEFAULT, H5P_DEFAULT));
+      ASSERT_TRUE(attr.valid());
+      ASSERT_GE(H5Awrite(attr, H5T_NATIVE_INT, &version), 0);
+    }
+    const std::string message = error_of([&] { read_bundle(path); });
+    expect_error(message, path, {"schema_version " + std::to_string(version),
+                                 version > 1 ? "newer lazyboe" : "older lazyboe"});
+    EXPECT_EQ(error_of([&] { read_bundle_header(path); }), message);
+  }
+}
+
+// Damaged files give our one line and nothing from HDF5 on stderr, in any thread.
+TEST(BundleFile, TruncatedFileQuietly) {
+  const std::string path = fresh_path("truncated");
+  write_bundle(path, random_bundle(50, 7, 13));
+  const std::string bytes = file_bytes(path);
+  fs::resize_file(path, bytes.size() / 2);
+  testing::internal::CaptureStderr();
+  std::string message, thread_message;
+  message = error_of([&] { read_bundle(path); });
+  std::thread([&] { thread_message = error_of([&] { read_bundle(path); }); }).join();
+  const std::string err = testing::internal::GetCapturedStderr();
+  expect_error(message, path, {"cannot open as an HDF5 file"});
+  EXPECT_EQ(thread_message, message);
+  EXPECT_EQ(err, "");
+}
+
+TEST(BundleFile, PlainHdf5FileIsNotABundle) {
+  const std::string path = fresh_path("plain");
+  { h5::File file = h5::create_file(path); }
+  expect_error(error_of([&] { read_bundle(path); }), path, {"schema_version missing"});
+}
+
+// Writes a good bundle, then damages it with the C API.
+std::string damaged(const std::string& name, const std::function<void(hid_t)>& damage) {
+  const std::string path = fresh_path(name);
+  write_bundle(path, random_bundle(50, 7, 21));
+  h5::File file = h5::open_file_rw(path);
+  damage(file);
+  h5::close_file(path, file);
+  return path;
+}
+
+TEST(BundleFile, MissingDataset) {
+  const std::string path = damaged("noqf", [](hid_t f) { ASSERT_GE(H5Ldelete(f, "/edges/qf", H5P_DEFAULT), 0); });
+  expect_error(error_of([&] { read_bundle(path); }), path, {"/edges/qf", "missing"});
+  read_bundle_header(path);  // the header alone is still fine
+}
+
+TEST(BundleFile, MissingAttribute) {
+  const std::string path = damaged("noattr", [](hid_t f) { ASSERT_GE(H5Adelete(f, "design_theta"), 0); });
+  expect_error(error_of([&] { read_bundle_header(path); }), path, {"attribute design_theta missing"});
+}
+
+TEST(BundleFile, WrongShape) {
+  const std::string path = damaged("shape", [](hid_t f) {
+    ASSERT_GE(H5Ldelete(f, "/edges/q0", H5P_DEFAULT), 0);
+    h5::write_dataset<double>("x", f, "/edges/q0", std::vector<double>(50 * 6), {50, 6});
+  });
+  expect_error(error_of([&] { read_bundle(path); }), path, {"/edges/q0", "shape 50 x 6, expected 50 x 7"});
+}
+
+TEST(BundleFile, WrongType) {
+  const std::string path = damaged("type", [](hid_t f) {
+    ASSERT_GE(H5Ldelete(f, "/edges/duration", H5P_DEFAULT), 0);
+    h5::write_dataset<float>("x", f, "/edges/duration", std::vector<float>(50), {50});
+  });
+  expect_error(error_of([&] { read_bundle(path); }), path, {"/edges/duration", "float32", "float64"});
+}
+
+void set_last_offset(hid_t f, const char* name, uint64_t delta, bool decrease_middle = false) {
+  std::vector<uint64_t> off = h5::read_dataset<uint64_t>("x", f, name, {51});
+  off.back() += delta;
+  if (decrease_middle) off[10] = off[11] + 1;
+  h5::Dataset d(H5Dopen2(f, name, H5P_DEFAULT));
+  ASSERT_GE(H5Dwrite(d, H5T_NATIVE_UINT64, H5S_ALL, H5S_ALL, H5P_DEFAULT, off.data()), 0);
+}
+
+TEST(BundleFile, KnotOffsetDisagreesWithKnots) {
+  const std::string path = damaged("knots", [](hid_t f) { set_last_offset(f, "/edges/knot_offset", 1); });
+  expect_error(error_of([&] { read_bundle(path); }), path,
+               {"/edges/knot_offset", "last value", "/controls/knots"});
+}
+
+TEST(BundleFile, SampleOffsetDecreases) {
+  const std::string path =
+      damaged("samples", [](hid_t f) { set_last_offset(f, "/edges/sample_offset", 0, true); });
+  expect_error(error_of([&] { read_bundle(path); }), path, {"/edges/sample_offset", "decreases at edge 10"});
+}
+
+TEST(BundleFile, RejectedAttributesMustPair) {
+  const std::string path = damaged("rejected", [](hid_t f) {
+    h5::write_attr_u64s("x", f, "rejected_counts", {1, 2});
+  });
+  expect_error(error_of([&] { read_bundle_header(path); }), path, {"rejected_counts", "rejected_reasons"});
+}
+
+}  // namespace
+}  // namespace lazyboe
