@@ -267,7 +267,8 @@ RobotModel load_robot(const std::string& config_path) {
   const nlohmann::json config = load_json_file(config_path);
   const JsonField root(config, config_path, "");
   root.allow_only({"schema_version", "name", "description", "urdf", "base_link", "tip_link",
-                   "gravity", "control_rate", "joints", "collision", "controller"});
+                   "gravity", "control_rate", "joints", "collision", "controller",
+                   "sampling_region"});
   if (root.at("schema_version").integer() != 1) {
     root.at("schema_version").fail("unsupported version (this build reads version 1)");
   }
@@ -453,6 +454,29 @@ RobotModel load_robot(const std::string& config_path) {
     model.dddq_max[i] = j.max_jerk;
     model.tau_max[i] = j.max_effort;
     model.dtau_max[i] = j.max_torque_rate;
+  }
+
+  model.region_lower = model.q_min;
+  model.region_upper = model.q_max;
+  if (root.has("sampling_region")) {
+    const JsonField region = root.at("sampling_region");
+    region.allow_only({"description", "lower", "upper"});
+    for (auto [key, bound] : {std::pair<const char*, JointVector*>{"lower", &model.region_lower},
+                              std::pair<const char*, JointVector*>{"upper", &model.region_upper}}) {
+      const std::vector<double> v = region.at(key).numbers();
+      if (static_cast<int>(v.size()) != n) {
+        region.at(key).fail("expected " + std::to_string(n) + " values, one per moving joint");
+      }
+      for (int i = 0; i < n; ++i) (*bound)[i] = v[i];
+    }
+    for (int i = 0; i < n; ++i) {
+      if (!(model.region_lower[i] < model.region_upper[i])) {
+        region.fail("joint " + std::to_string(i + 1) + ": lower must be below upper");
+      }
+      if (model.region_lower[i] < model.q_min[i] || model.region_upper[i] > model.q_max[i]) {
+        region.fail("joint " + std::to_string(i + 1) + ": outside the joint limits");
+      }
+    }
   }
 
   // A chain whose mass matrix is singular (a moving body with no mass or inertia about its

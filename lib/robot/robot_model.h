@@ -98,6 +98,10 @@ struct RobotModel {
 
   ControllerGains controller;
 
+  // Default box of start states for the edge bundle (config "sampling_region"; the joint
+  // limits when the config has none).
+  JointVector region_lower, region_upper;
+
   // Limits gathered as vectors for the validity checks.
   JointVector q_min, q_max, dq_max, ddq_max, dddq_max, tau_max, dtau_max;
 

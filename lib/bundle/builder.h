@@ -1,0 +1,74 @@
+// Generating the edge bundle (paper, Methods A-B): random collision-free start states in a
+// region, random varying velocity commands, simulated and validated by the shared Simulator.
+// Attempt a is a function of (seed, a) alone; the bundle holds the valid attempts in attempt
+// order, so its contents do not depend on the thread count, and an interrupted build resumed
+// later equals an uninterrupted one.
+#pragma once
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "bundle/bundle.h"
+#include "sim/simulator.h"
+
+namespace lazyboe {
+
+// Everything that decides the bundle's contents (all stored in its header).
+struct BuildSettings {
+  uint64_t edges = 100000;
+  uint64_t seed = 1;
+  JointVector region_lower, region_upper;
+  CommandSampling command;
+  SimulationOptions simulation;
+  double design_theta = 0.35;
+};
+
+// How the build runs, not what it makes.
+struct BuildControl {
+  int threads = 0;                  // 0: all available
+  double checkpoint_seconds = 10;   // at least this long between checkpoints
+  bool quiet = false;
+  std::function<bool()> stop_requested;               // polled between rounds
+  std::function<void(const Bundle&)> save_checkpoint;  // persists the bundle so far
+};
+
+struct EdgeAttempt {
+  RolloutStatus status = RolloutStatus::Valid;
+  bool start_found = true;       // a collision-free start was found in the region
+  uint64_t start_resamples = 0;  // starts drawn again because they were in collision
+  JointVector q0, qf;
+  double duration = 0, command_duration = 0;
+  std::vector<double> knots;
+  std::vector<float> sample_q, sample_dq;
+  bool valid() const { return start_found && status == RolloutStatus::Valid; }
+  const char* reason() const;
+};
+
+constexpr int kMaxStartSamples = 1000;  // per attempt, before it counts as start_in_collision
+
+void generate_edge(const Simulator& sim, SimulatorWorkspace& ws, const BuildSettings& settings,
+                   uint64_t attempt, EdgeAttempt& out);
+
+// A new, empty bundle whose header describes the inputs and settings.
+Bundle new_bundle(const RobotModel& robot, const Environment& env, const BuildSettings& settings);
+
+// The settings a bundle header records (for resuming).
+BuildSettings settings_from_header(const BundleHeader& header);
+
+// Refuses to resume `existing` with `wanted`: names the first parameter, robot or environment
+// that differs.
+void check_resume_compatible(const BundleHeader& existing, const BundleHeader& wanted,
+                             const std::string& path);
+
+// Fails (naming the region) when no collision-free start can be found in it.
+void check_region(const Simulator& sim, const BuildSettings& settings);
+
+enum class BuildOutcome { Complete, Interrupted };
+
+// Grows `bundle` to settings.edges valid edges. Saves checkpoints as it goes and a last one
+// at the end (complete) or on interruption (incomplete).
+BuildOutcome build_bundle(const Simulator& sim, const BuildSettings& settings, Bundle& bundle,
+                          const BuildControl& control);
+
+}  // namespace lazyboe

@@ -1,0 +1,95 @@
+#include "bundle/inspect.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "bundle/bundle_file.h"
+#include "common/histogram.h"
+#include "sim/random.h"
+
+namespace lazyboe {
+
+std::vector<double> neighbour_counts(const Bundle& b, double theta, int points, uint64_t seed) {
+  const int n = b.dof();
+  const size_t N = b.size();
+  Random rng(seed, 0);
+  std::vector<double> counts;
+  std::vector<double> p(n);
+  const double r2 = theta * theta;
+  for (int k = 0; k < points; ++k) {
+    for (int i = 0; i < n; ++i) p[i] = rng.uniform(b.header.region_lower[i], b.header.region_upper[i]);
+    size_t c = 0;
+    for (size_t e = 0; e < N; ++e) {
+      double d2 = 0;
+      for (int i = 0; i < n && d2 <= r2; ++i) {
+        const double d = b.q0[e * n + i] - p[i];
+        d2 += d * d;
+      }
+      c += d2 <= r2;
+    }
+    counts.push_back(static_cast<double>(c));
+  }
+  return counts;
+}
+
+void print_inspection(const std::string& path, std::FILE* out) {
+  const Bundle b = read_bundle(path);
+  const BundleHeader& h = b.header;
+  const int n = b.dof();
+  const size_t N = b.size();
+  std::fprintf(out, "bundle %s\n", path.c_str());
+  std::fprintf(out, "  schema version %d, written by lazyboe %s, %s\n", h.schema_version,
+               h.tool_version.c_str(), h.complete ? "complete" : "INCOMPLETE (resume with lazyboe-build --resume --out FILE)");
+  std::fprintf(out, "  robot %s (%s, hash %s), %d joints\n", h.robot_name.c_str(), h.robot_config.c_str(),
+               h.robot_hash.c_str(), n);
+  std::fprintf(out, "  environment %s (%s, hash %s)\n", h.env_name.c_str(), h.env_file.c_str(), h.env_hash.c_str());
+  std::fprintf(out, "  edges %zu of %llu, seed %llu, design theta %g rad\n", N,
+               static_cast<unsigned long long>(h.target_edges), static_cast<unsigned long long>(h.seed), h.design_theta);
+  std::fprintf(out, "  commands %g-%g s, knots every ~%g s, speed <= %g x limit, accel/jerk <= %g x limit\n",
+               h.min_duration, h.max_duration, h.knot_interval, h.velocity_scale, h.limit_scale);
+  std::fprintf(out, "  simulation %s x%d at %g Hz, trajectory samples every %g s\n", h.integrator.c_str(),
+               h.substeps, h.control_rate, h.sample_interval);
+  std::fprintf(out, "  region:");
+  for (int i = 0; i < n; ++i) std::fprintf(out, " [%g, %g]", h.region_lower[i], h.region_upper[i]);
+  std::fprintf(out, "\n  attempts %llu, valid %llu (%.1f%%), start states resampled %llu\n",
+               static_cast<unsigned long long>(h.attempts), static_cast<unsigned long long>(h.valid),
+               h.attempts ? 100.0 * h.valid / h.attempts : 0.0, static_cast<unsigned long long>(h.start_resamples));
+  for (const auto& [reason, count] : h.rejected) {
+    std::fprintf(out, "    rejected %-20s %llu\n", reason.c_str(), static_cast<unsigned long long>(count));
+  }
+  std::fprintf(out, "  simulated %.1f s, wall %.1f s\n", h.simulated_seconds, h.wall_seconds);
+  if (N == 0) return;
+
+  std::vector<double> displacement(N);
+  for (size_t e = 0; e < N; ++e) {
+    double d2 = 0;
+    for (int i = 0; i < n; ++i) d2 += std::pow(b.qf[e * n + i] - b.q0[e * n + i], 2);
+    displacement[e] = std::sqrt(d2);
+  }
+  const Quantiles qd = quantiles(b.duration), qx = quantiles(displacement);
+  std::fprintf(out, "\nedge duration (s): mean %.3f, median %.3f, min %.3f, max %.3f\n", qd.mean, qd.median, qd.min, qd.max);
+  std::fputs(text_histogram(b.duration, qd.min, qd.max, 8).c_str(), out);
+  std::fprintf(out, "edge displacement |qf - q0| (rad): mean %.3f, median %.3f, max %.3f\n", qx.mean, qx.median, qx.max);
+  std::fputs(text_histogram(displacement, 0, qx.max, 8).c_str(), out);
+
+  std::fprintf(out, "coverage of the region by edge starts (share of edges per tenth of each joint's range):\n");
+  for (int i = 0; i < n; ++i) {
+    int bins[10] = {0};
+    for (size_t e = 0; e < N; ++e) {
+      const double f = (b.q0[e * n + i] - h.region_lower[i]) / (h.region_upper[i] - h.region_lower[i]);
+      bins[std::clamp(static_cast<int>(f * 10), 0, 9)]++;
+    }
+    std::fprintf(out, "  joint %d:", i + 1);
+    for (int k = 0; k < 10; ++k) std::fprintf(out, " %4.1f", 100.0 * bins[k] / N);
+    std::fprintf(out, " %%\n");
+  }
+  const std::vector<double> counts = neighbour_counts(b, h.design_theta, 500, 7);
+  const Quantiles qn = quantiles(counts);
+  size_t zero = 0;
+  for (double c : counts) zero += c == 0;
+  std::fprintf(out, "edge starts within theta = %g of 500 random region points: mean %.1f, median %.0f, "
+                    "10th percentile %.0f, none for %.1f%% of points\n",
+               h.design_theta, qn.mean, qn.median, qn.p10, 100.0 * zero / counts.size());
+}
+
+}  // namespace lazyboe

@@ -1,0 +1,18 @@
+// `lazyboe-build --inspect`: a bundle's header and statistics (edge durations and
+// displacements, coverage of the sampling region, neighbours within theta).
+#pragma once
+
+#include <cstdio>
+#include <string>
+
+#include "bundle/bundle.h"
+
+namespace lazyboe {
+
+void print_inspection(const std::string& path, std::FILE* out);
+
+// Edge starts within `theta` (Euclidean, joint space) of random points of the sampling region:
+// the design check that a bundle holds enough neighbours for the planner.
+std::vector<double> neighbour_counts(const Bundle& bundle, double theta, int points, uint64_t seed);
+
+}  // namespace lazyboe

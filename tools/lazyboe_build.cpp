@@ -1,0 +1,228 @@
+// lazyboe-build: generate the edge bundle (valid random rollouts of the robot's dynamics) in
+// parallel and store it in HDF5; or --inspect an existing bundle.
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <csignal>
+#include <cstdio>
+#include <filesystem>
+#include <sstream>
+
+#include "bundle/builder.h"
+#include "bundle/bundle_file.h"
+#include "bundle/inspect.h"
+#include "common/json_fields.h"
+#include "tool_main.h"
+
+namespace {
+
+using namespace lazyboe;
+
+std::atomic<bool> g_stop{false};
+
+void on_signal(int) {
+  g_stop = true;
+  // A second Ctrl-C ends the process at once; the last checkpoint on disk stays valid.
+  std::signal(SIGINT, SIG_DFL);
+  std::signal(SIGTERM, SIG_DFL);
+}
+
+// --region: "default" (the robot config's sampling_region), "limits" (the joint limits), a JSON
+// file {"lower": [...], "upper": [...]}, or inline "lo1:hi1,lo2:hi2,...".
+void parse_region(const std::string& text, const RobotModel& robot, JointVector& lower, JointVector& upper) {
+  const int n = robot.dof;
+  if (text == "default") {
+    lower = robot.region_lower;
+    upper = robot.region_upper;
+    return;
+  }
+  if (text == "limits") {
+    lower = robot.q_min;
+    upper = robot.q_max;
+    return;
+  }
+  lower.resize(n);
+  upper.resize(n);
+  if (std::filesystem::exists(text)) {
+    const nlohmann::json doc = load_json_file(text);
+    const JsonField root(doc, text, "");
+    root.allow_only({"description", "lower", "upper"});
+    const std::vector<double> lo = root.at("lower").numbers(), hi = root.at("upper").numbers();
+    if (static_cast<int>(lo.size()) != n) root.at("lower").fail("expected " + std::to_string(n) + " values");
+    if (static_cast<int>(hi.size()) != n) root.at("upper").fail("expected " + std::to_string(n) + " values");
+    for (int i = 0; i < n; ++i) {
+      lower[i] = lo[i];
+      upper[i] = hi[i];
+    }
+    return;
+  }
+  std::stringstream ss(text);
+  std::string item;
+  int i = 0;
+  while (std::getline(ss, item, ',')) {
+    double lo = 0, hi = 0;
+    char colon = 0, extra = 0;
+    std::istringstream is(item);
+    if (!(is >> lo >> colon >> hi) || colon != ':' || (is >> extra) || !std::isfinite(lo) || !std::isfinite(hi)) {
+      fail("--region", "'" + text + "' is not a file, 'default', 'limits', or lo:hi pairs (bad item '" + item + "')");
+    }
+    if (i >= n) fail("--region", "more than " + std::to_string(n) + " lo:hi pairs");
+    lower[i] = lo;
+    upper[i] = hi;
+    ++i;
+  }
+  if (i != n) fail("--region", "expected " + std::to_string(n) + " lo:hi pairs, got " + std::to_string(i));
+}
+
+Integrator parse_integrator(const std::string& name) {
+  if (name == "euler") return Integrator::SemiImplicitEuler;
+  if (name == "rk4") return Integrator::RK4;
+  fail("--integrator", "expected euler or rk4, got '" + name + "'");
+}
+
+void print_summary(const Bundle& b) {
+  const BundleHeader& h = b.header;
+  std::fprintf(stderr, "lazyboe-build: %zu edges (%s)\n", b.size(), h.complete ? "complete" : "incomplete");
+  std::fprintf(stderr, "  attempts %llu, valid %llu (%.1f%%), start states resampled %llu\n",
+               static_cast<unsigned long long>(h.attempts), static_cast<unsigned long long>(h.valid),
+               h.attempts ? 100.0 * h.valid / h.attempts : 0.0, static_cast<unsigned long long>(h.start_resamples));
+  for (const auto& [reason, count] : h.rejected) {
+    std::fprintf(stderr, "  rejected %-20s %llu\n", reason.c_str(), static_cast<unsigned long long>(count));
+  }
+  std::fprintf(stderr, "  simulated %.1f s in %.1f s wall: %.0f attempts/s, %.0f valid edges/s\n",
+               h.simulated_seconds, h.wall_seconds, h.wall_seconds > 0 ? h.attempts / h.wall_seconds : 0.0,
+               h.wall_seconds > 0 ? h.valid / h.wall_seconds : 0.0);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Generate an edge bundle: valid random rollouts of the robot's dynamics, in HDF5."};
+  std::string robot_path = default_robot_path(), env_path = default_environment_path();
+  std::string out_path, inspect_path, region = "default", integrator = "euler";
+  BuildSettings s;
+  BuildControl control;
+  double sample_interval = 0.05;
+  bool resume = false, force = false;
+  app.add_option("--robot", robot_path, "Robot config (JSON)")->capture_default_str();
+  app.add_option("--env", env_path, "Environment (JSON)")->capture_default_str();
+  app.add_option("--out", out_path, "Bundle file to write (HDF5)");
+  app.add_option("--edges", s.edges, "Valid edges to generate")->capture_default_str();
+  app.add_option("--seed", s.seed, "Random seed")->capture_default_str();
+  app.add_option("--threads", control.threads, "Threads (0: all cores)")->capture_default_str();
+  app.add_option("--region", region,
+                 "Start-state box: default (robot config), limits, a JSON file, or lo:hi,... per joint")
+      ->capture_default_str();
+  app.add_option("--min-duration", s.command.min_duration, "Shortest velocity command, s")->capture_default_str();
+  app.add_option("--max-duration", s.command.max_duration, "Longest velocity command, s")->capture_default_str();
+  app.add_option("--knot-interval", s.command.knot_interval, "Nominal spacing of velocity knots, s")->capture_default_str();
+  app.add_option("--velocity-scale", s.command.velocity_scale, "Knot speeds up to this fraction of the velocity limits")
+      ->capture_default_str();
+  app.add_option("--limit-scale", s.command.limit_scale,
+                 "Commanded acceleration and jerk up to this fraction of the limits")->capture_default_str();
+  app.add_option("--integrator", integrator, "euler (semi-implicit) or rk4")->capture_default_str();
+  app.add_option("--substeps", s.simulation.substeps, "Integration steps per control period")->capture_default_str();
+  app.add_option("--sample-interval", sample_interval, "Stored trajectory spacing, s (0: none)")->capture_default_str();
+  app.add_option("--theta", s.design_theta, "Neighbourhood radius the bundle is designed for (rad)")->capture_default_str();
+  app.add_option("--checkpoint-seconds", control.checkpoint_seconds, "Least time between checkpoints")
+      ->capture_default_str();
+  app.add_flag("--resume", resume, "Continue an interrupted build in --out (to --edges)");
+  app.add_flag("--force", force, "Overwrite an existing --out");
+  app.add_flag("--quiet", control.quiet, "No progress output");
+  app.add_option("--inspect", inspect_path, "Print the header and statistics of a bundle, then exit");
+  one_line_cli_errors(app, "lazyboe-build");
+  CLI11_PARSE(app, argc, argv);
+
+  return run_tool("lazyboe-build", [&]() -> int {
+    if (!inspect_path.empty()) {
+      print_inspection(inspect_path, stdout);
+      return 0;
+    }
+    if (out_path.empty()) fail("--out", "required (the bundle file to write)");
+    if (resume && force) fail("--resume", "cannot be combined with --force");
+    if (s.edges == 0) fail("--edges", "must be > 0");
+    if (!(s.command.min_duration > 0)) fail("--min-duration", "must be > 0");
+    if (!(s.command.max_duration >= s.command.min_duration)) {
+      fail("--max-duration", "must be >= --min-duration");
+    }
+    if (!(s.command.knot_interval > 0)) fail("--knot-interval", "must be > 0");
+    if (!(s.command.velocity_scale > 0 && s.command.velocity_scale <= 1)) fail("--velocity-scale", "must be in (0, 1]");
+    if (!(s.command.limit_scale > 0 && s.command.limit_scale <= 1)) fail("--limit-scale", "must be in (0, 1]");
+    if (s.simulation.substeps < 1) fail("--substeps", "must be >= 1");
+    if (!(s.design_theta > 0)) fail("--theta", "must be > 0");
+    if (control.threads < 0) fail("--threads", "must be >= 0");
+    if (!(sample_interval >= 0)) fail("--sample-interval", "must be >= 0");
+    s.simulation.integrator = parse_integrator(integrator);
+
+    // A resumed build takes every setting from the file; options given now must agree with it.
+    Bundle existing;
+    const bool exists = std::filesystem::exists(out_path);
+    if (resume) {
+      if (!exists) fail(out_path, "cannot resume: no such file");
+      existing = read_bundle(out_path);
+      const BundleHeader& h = existing.header;
+      if (!app.count("--robot")) robot_path = h.robot_config;
+      if (!app.count("--env")) env_path = h.env_file;
+      const BuildSettings from = settings_from_header(h);
+      if (!app.count("--edges")) s.edges = from.edges;
+      if (!app.count("--seed")) s.seed = from.seed;
+      if (!app.count("--min-duration")) s.command.min_duration = from.command.min_duration;
+      if (!app.count("--max-duration")) s.command.max_duration = from.command.max_duration;
+      if (!app.count("--knot-interval")) s.command.knot_interval = from.command.knot_interval;
+      if (!app.count("--velocity-scale")) s.command.velocity_scale = from.command.velocity_scale;
+      if (!app.count("--limit-scale")) s.command.limit_scale = from.command.limit_scale;
+      if (!app.count("--integrator")) s.simulation.integrator = from.simulation.integrator;
+      if (!app.count("--substeps")) s.simulation.substeps = from.simulation.substeps;
+      if (!app.count("--sample-interval")) sample_interval = h.sample_interval;
+      if (!app.count("--theta")) s.design_theta = from.design_theta;
+      if (!app.count("--region")) {
+        s.region_lower = from.region_lower;
+        s.region_upper = from.region_upper;
+      }
+    } else if (exists && !force) {
+      fail(out_path, "already exists (use --force to overwrite, or --resume to continue it)");
+    }
+
+    const RobotModel robot = load_robot(robot_path);
+    const Environment env = load_environment(env_path);
+    const CollisionModel collision = build_collision_model(robot, env);
+    s.simulation.sample_every = static_cast<int>(std::lround(sample_interval * robot.control_rate));
+    if (sample_interval > 0 && std::abs(s.simulation.sample_every / robot.control_rate - sample_interval) > 1e-9) {
+      fail("--sample-interval", "must be a multiple of the control period (" + std::to_string(1 / robot.control_rate) + " s)");
+    }
+    if (!resume || app.count("--region")) parse_region(region, robot, s.region_lower, s.region_upper);
+    const Simulator sim(robot, collision, s.simulation);
+    check_region(sim, s);
+
+    Bundle bundle = new_bundle(robot, env, s);
+    if (resume) {
+      check_resume_compatible(existing.header, bundle.header, out_path);
+      if (existing.size() > s.edges) {
+        fail("--edges", "the file already holds " + std::to_string(existing.size()) + " edges");
+      }
+      if (existing.size() == s.edges && existing.header.complete) {
+        std::fprintf(stderr, "lazyboe-build: %s is already complete with %zu edges\n", out_path.c_str(), existing.size());
+        return 0;
+      }
+      existing.header.target_edges = s.edges;
+      existing.header.complete = false;
+      existing.header.tool_version = LAZYBOE_VERSION;
+      bundle = std::move(existing);
+      std::fprintf(stderr, "lazyboe-build: resuming %s at %zu of %llu edges\n", out_path.c_str(),
+                   bundle.size(), static_cast<unsigned long long>(s.edges));
+    }
+
+    std::signal(SIGINT, on_signal);
+    std::signal(SIGTERM, on_signal);
+    control.stop_requested = [] { return g_stop.load(); };
+    control.save_checkpoint = [&](const Bundle& b) { write_bundle(out_path, b); };
+    const BuildOutcome outcome = build_bundle(sim, s, bundle, control);
+    if (!control.quiet) print_summary(bundle);
+    if (outcome == BuildOutcome::Interrupted) {
+      std::fprintf(stderr, "lazyboe-build: interrupted; %s holds %zu edges. Continue with: lazyboe-build --resume --out %s\n",
+                   out_path.c_str(), bundle.size(), out_path.c_str());
+      return 130;
+    }
+    return 0;
+  });
+}
