@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include <fcl/narrowphase/detail/convexity_based_algorithm/gjk.h>
+#include <fcl/narrowphase/detail/convexity_based_algorithm/minkowski_diff.h>
 #include <fcl/narrowphase/detail/primitive_shape_algorithm/capsule_capsule.h>
 
 #include "common/error.h"
@@ -65,18 +67,23 @@ inline bool spheres_may_touch(const CollisionData& data, const CollisionModel& m
   return (data.sphere_centre[a] - data.sphere_centre[b]).squaredNorm() <= r * r;
 }
 
-bool narrow_collide(CollisionData& data, const fcl::CollisionGeometryd* g1,
-                    const fcl::Transform3d& t1, const fcl::CollisionGeometryd* g2,
-                    const fcl::Transform3d& t2) {
-  data.result.clear();
-  return fcl::collide(g1, t1, g2, t2, data.request, data.result) > 0;
+// Intersection of two convex FCL shapes by FCL's own GJK (the boolean answer only: no EPA
+// penetration pass and no heap allocation, unlike fcl::collide's libccd path).
+bool narrow_collide(const fcl::CollisionGeometryd* g1, const fcl::Transform3d& t1,
+                    const fcl::CollisionGeometryd* g2, const fcl::Transform3d& t2) {
+  fcl::detail::MinkowskiDiff<double> diff;
+  diff.shapes[0] = static_cast<const fcl::ShapeBased*>(g1);
+  diff.shapes[1] = static_cast<const fcl::ShapeBased*>(g2);
+  diff.toshape1.noalias() = t2.linear().transpose() * t1.linear();
+  diff.toshape0 = t1.inverse(Eigen::Isometry) * t2;
+  fcl::detail::GJK<double> gjk(128, 1e-8);
+  return gjk.evaluate(diff, -Eigen::Vector3d::UnitX()) == fcl::detail::GJK<double>::Inside;
 }
 
 double narrow_distance(CollisionData& data, const fcl::CollisionGeometryd* g1,
                        const fcl::Transform3d& t1, const fcl::CollisionGeometryd* g2,
                        const fcl::Transform3d& t2) {
-  data.result.clear();
-  if (fcl::collide(g1, t1, g2, t2, data.request, data.result) > 0) return 0;
+  if (narrow_collide(g1, t1, g2, t2)) return 0;
   data.distance_result.clear();
   const double d = fcl::distance(g1, t1, g2, t2, data.distance_request, data.distance_result);
   return std::max(0.0, d);
@@ -97,7 +104,7 @@ bool self_collides(const CollisionModel& model, CollisionData& data, int a, int 
   if (model.robot[a].capsule && model.robot[b].capsule) {
     return capsule_distance(model, data, a, b) < model.margin;
   }
-  return narrow_collide(data, model.robot[a].inflated.get(), data.transform[a],
+  return narrow_collide(model.robot[a].inflated.get(), data.transform[a],
                         model.robot[b].exact.get(), data.transform[b]);
 }
 
@@ -107,7 +114,7 @@ bool env_collides(const CollisionModel& model, CollisionData& data, int a, int o
                             obstacle)) {
     return false;
   }
-  return narrow_collide(data, model.robot[a].inflated.get(), data.transform[a],
+  return narrow_collide(model.robot[a].inflated.get(), data.transform[a],
                         obstacle.geometry.get(), obstacle.transform);
 }
 
@@ -172,12 +179,7 @@ CollisionModel build_collision_model(const RobotModel& robot, const Environment&
 CollisionData::CollisionData(const CollisionModel& model)
     : transform(model.robot.size(), fcl::Transform3d::Identity()),
       sphere_centre(model.robot.size(), Eigen::Vector3d::Zero()) {
-  request.num_max_contacts = 1;
-  // FCL's own GJK (not libccd): specialised capsule/sphere routines, no allocation per call.
-  request.gjk_solver_type = fcl::GST_LIBCCD;
   distance_request.gjk_solver_type = fcl::GST_INDEP;
-  request.enable_contact = false;
-  result.clear();
 }
 
 void update_collision_transforms(const CollisionModel& model, CollisionData& data,

@@ -57,8 +57,6 @@ struct CollisionData {
   explicit CollisionData(const CollisionModel& model);
   std::vector<fcl::Transform3d> transform;     // robot shapes in the base frame
   std::vector<Eigen::Vector3d> sphere_centre;  // bounding-sphere centres in the base frame
-  fcl::CollisionRequestd request;
-  fcl::CollisionResultd result;
   fcl::DistanceRequestd distance_request;
   fcl::DistanceResultd distance_result;
 };

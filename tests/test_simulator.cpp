@@ -1,0 +1,277 @@
+// The simulator: command profiles within the limits at 1 kHz, rollouts that start and end at
+// rest, dynamics (not kinematics) deciding the end state, collision checks dense enough, limit
+// violations caught, determinism, resumable generation, and no allocation per rollout.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cstdlib>
+#include <new>
+
+#include "bundle/builder.h"
+#include "sim/simulator.h"
+#include "test_util.h"
+
+static std::atomic<long> g_allocations{0};
+void* operator new(std::size_t size) {
+  ++g_allocations;
+  if (void* p = std::malloc(size ? size : 1)) return p;
+  throw std::bad_alloc();
+}
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+
+namespace lazyboe {
+namespace {
+
+struct Scene {
+  RobotModel robot = test::panda();
+  Environment env;
+  CollisionModel collision;
+  Simulator sim;
+  explicit Scene(const std::string& env_name, SimulationOptions options = {})
+      : env(load_environment(test::source_path("data/environments/" + env_name + ".json"))),
+        collision(build_collision_model(robot, env)),
+        sim(robot, collision, options) {}
+};
+
+BuildSettings default_settings(const RobotModel& robot) {
+  BuildSettings s;
+  s.region_lower = robot.region_lower;
+  s.region_upper = robot.region_upper;
+  return s;
+}
+
+CommandProfile view(const EdgeAttempt& e, int dof) {
+  return CommandProfile{e.knots.data(), static_cast<int>(e.knots.size() / dof), dof, e.command_duration};
+}
+
+TEST(CommandProfile, StartsAndEndsAtRestWithinLimitsAtControlRate) {
+  const RobotModel& robot = test::panda();
+  const CommandSampling sampling;
+  std::vector<double> knots;
+  const double dt = 1.0 / robot.control_rate;
+  for (uint64_t k = 0; k < 200; ++k) {
+    Random rng(3, k);
+    const double T = sample_command_profile(robot, sampling, rng, knots);
+    ASSERT_GE(T, sampling.min_duration);
+    ASSERT_LE(T, sampling.max_duration);
+    const CommandProfile p{knots.data(), static_cast<int>(knots.size() / 7), 7, T};
+    double v[7], a[7], off[7], v_prev[7] = {0}, a_prev[7] = {0}, integral[7] = {0};
+    for (int i = 0; i < 7; ++i) {
+      EXPECT_EQ(knots[i], 0.0);
+      EXPECT_EQ(knots[(p.n_knots - 1) * 7 + i], 0.0);
+    }
+    const int ticks = static_cast<int>(T / dt) + 2;
+    for (int tick = 0; tick <= ticks; ++tick) {
+      // The position offset is the exact integral of the velocity: compare with a fine
+      // trapezoid sum over this tick (error ~1e-9).
+      if (tick > 0) {
+        double vf[7], af[7], of[7], va[7];
+        evaluate_command(p, (tick - 1) * dt, va, af, of);
+        for (int sub = 1; sub <= 20; ++sub) {
+          evaluate_command(p, (tick - 1 + sub / 20.0) * dt, vf, af, of);
+          for (int i = 0; i < 7; ++i) {
+            integral[i] += 0.5 * (va[i] + vf[i]) * dt / 20;
+            va[i] = vf[i];
+          }
+        }
+      }
+      evaluate_command(p, tick * dt, v, a, off);
+      for (int i = 0; i < 7; ++i) {
+        EXPECT_LE(std::abs(v[i]), robot.dq_max[i]);
+        // Finite differences at 1 kHz, as the robot's controller checks the stream.
+        const double acc = (v[i] - v_prev[i]) / dt, jerk = (acc - a_prev[i]) / dt;
+        EXPECT_LE(std::abs(acc), sampling.limit_scale * robot.ddq_max[i] * 1.001) << "tick " << tick;
+        EXPECT_LE(std::abs(jerk), sampling.limit_scale * robot.dddq_max[i] * 1.001) << "tick " << tick;
+        EXPECT_NEAR(a[i], acc, robot.dddq_max[i] * dt);
+        EXPECT_NEAR(off[i], integral[i], 1e-7);
+        v_prev[i] = v[i];
+        a_prev[i] = acc;
+      }
+    }
+    for (int i = 0; i < 7; ++i) EXPECT_EQ(v[i], 0.0);
+  }
+}
+
+TEST(Simulator, ValidRolloutsStartAndEndAtRestAndStayCollisionFree) {
+  SimulationOptions options;
+  options.sample_every = 1;  // every tick, to re-check them all below
+  Scene scene("table", options);
+  SimulatorWorkspace ws(scene.sim);
+  const BuildSettings settings = default_settings(scene.robot);
+  int valid = 0;
+  for (uint64_t a = 0; a < 60; ++a) {
+    EdgeAttempt e;
+    generate_edge(scene.sim, ws, settings, a, e);
+    if (!e.valid()) continue;
+    ++valid;
+    const size_t rows = e.sample_q.size() / 7;
+    ASSERT_GE(rows, 2u);
+    for (int i = 0; i < 7; ++i) {
+      EXPECT_EQ(e.sample_dq[i], 0.0f);  // starts at rest
+      EXPECT_LE(std::abs(e.sample_dq[(rows - 1) * 7 + i]), scene.sim.options.settle_velocity * 1.0001);
+      EXPECT_FLOAT_EQ(e.sample_q[(rows - 1) * 7 + i], static_cast<float>(e.qf[i]));
+    }
+    EXPECT_GT(e.duration, e.command_duration);  // includes settling
+    // Every simulated tick is collision-free and within the limits: the sparse checks missed
+    // nothing.
+    for (size_t r = 0; r < rows; ++r) {
+      JointVector q(7);
+      for (int i = 0; i < 7; ++i) q[i] = e.sample_q[r * 7 + i];
+      EXPECT_EQ(check_state(scene.sim, ws, q), RolloutStatus::Valid) << "attempt " << a << " row " << r;
+    }
+  }
+  EXPECT_GT(valid, 40);
+}
+
+TEST(Simulator, EndStateComesFromTheDynamics) {
+  Scene scene("empty");
+  SimulatorWorkspace ws(scene.sim);
+  const BuildSettings settings = default_settings(scene.robot);
+  EdgeAttempt e;
+  uint64_t a = 0;
+  do generate_edge(scene.sim, ws, settings, a++, e);
+  while (!e.valid());
+  const CommandProfile p = view(e, 7);
+  double v[7], acc[7], off[7];
+  evaluate_command(p, 1e9, v, acc, off);
+  JointVector kinematic = e.q0;
+  for (int i = 0; i < 7; ++i) kinematic[i] += off[i];
+  // Not a kinematic integration of the commands...
+  EXPECT_GT((e.qf - kinematic).norm(), 1e-4);
+  // ...but close to it (the controller tracks the commands).
+  EXPECT_LT((e.qf - kinematic).norm(), 0.1 * (e.qf - e.q0).norm());
+  // The same commands from a shifted start do not simply shift the end state.
+  JointVector shifted = e.q0;
+  shifted[1] += 0.05;
+  shifted[3] -= 0.05;
+  const RolloutResult r = simulate(scene.sim, ws, shifted, p);
+  ASSERT_TRUE(r.valid());
+  const double nonlinear = ((r.qf - e.qf) - (shifted - e.q0)).norm();
+  EXPECT_GT(nonlinear, 1e-6);
+  EXPECT_LT(nonlinear, 0.05);
+}
+
+TEST(Simulator, ReplayingAStoredEdgeReproducesItExactly) {
+  Scene scene("table");
+  SimulatorWorkspace ws(scene.sim);
+  const BuildSettings settings = default_settings(scene.robot);
+  for (uint64_t a = 0; a < 20; ++a) {
+    EdgeAttempt e;
+    generate_edge(scene.sim, ws, settings, a, e);
+    const RolloutResult r = simulate(scene.sim, ws, e.q0, view(e, 7));
+    EXPECT_EQ(r.status, e.status);
+    if (e.valid()) {
+      EXPECT_EQ(r.qf, e.qf);
+      EXPECT_EQ(r.duration, e.duration);
+    }
+  }
+}
+
+TEST(Simulator, ViolationsAreCaught) {
+  // Into the table: a start right above it and a command driving joint 2 forward.
+  Scene scene("table");
+  SimulatorWorkspace ws(scene.sim);
+  JointVector q0(7);
+  q0 << 0, 0.55, 0, -1.6, 0, 2.1, 0.8;
+  ASSERT_EQ(check_state(scene.sim, ws, q0), RolloutStatus::Valid);
+  std::vector<double> knots(5 * 7, 0.0);
+  for (int k = 1; k < 4; ++k) knots[k * 7 + 1] = 0.8;  // shoulder forward
+  const CommandProfile down{knots.data(), 5, 7, 1.2};
+  EXPECT_EQ(simulate(scene.sim, ws, q0, down).status, RolloutStatus::EnvCollision);
+
+  // Beyond the velocity limit: knots above dq_max on joint 1.
+  Scene empty("empty");
+  SimulatorWorkspace ws2(empty.sim);
+  JointVector ready(7);
+  ready << 0, -0.785, 0, -2.356, 0, 1.571, 0.785;
+  std::vector<double> fast(3 * 7, 0.0);
+  fast[7 + 0] = 2.5;  // dq_max is 2.175
+  const CommandProfile too_fast{fast.data(), 3, 7, 3.0};
+  EXPECT_EQ(simulate(empty.sim, ws2, ready, too_fast).status, RolloutStatus::VelocityLimit);
+
+  // A sudden step in the command breaks acceleration/jerk continuity.
+  std::vector<double> step(3 * 7, 0.0);
+  step[7 + 5] = 1.5;
+  const CommandProfile abrupt{step.data(), 3, 7, 0.02};
+  const RolloutStatus s = simulate(empty.sim, ws2, ready, abrupt).status;
+  EXPECT_TRUE(s == RolloutStatus::JerkLimit || s == RolloutStatus::AccelerationLimit ||
+              s == RolloutStatus::TorqueRateLimit)
+      << rollout_status_name(s);
+
+  // Torque limit: the same gentle motion with the wrist's effort limit cut to 0.01 Nm.
+  RobotModel weak = test::panda();
+  weak.tau_max[1] = 0.5;  // cannot hold the shoulder against gravity
+  const Simulator weak_sim(weak, empty.collision, {});
+  SimulatorWorkspace ws3(weak_sim);
+  std::vector<double> gentle(3 * 7, 0.0);
+  gentle[7 + 0] = 0.1;
+  const CommandProfile slow{gentle.data(), 3, 7, 0.5};
+  EXPECT_EQ(simulate(weak_sim, ws3, ready, slow).status, RolloutStatus::TorqueLimit);
+}
+
+TEST(Simulator, RolloutAllocatesNothingWithReservedSamples) {
+  Scene scene("table");
+  SimulatorWorkspace ws(scene.sim);
+  const BuildSettings settings = default_settings(scene.robot);
+  EdgeAttempt e;
+  e.knots.reserve(64);
+  e.sample_q.reserve(4096);
+  e.sample_dq.reserve(4096);
+  generate_edge(scene.sim, ws, settings, 0, e);  // warm-up sizes q0/qf
+  const long before = g_allocations.load();
+  for (uint64_t a = 1; a < 20; ++a) generate_edge(scene.sim, ws, settings, a, e);
+  EXPECT_EQ(g_allocations.load() - before, 0);
+}
+
+// The bundle's contents depend only on (seed, attempt): any thread count, and a build stopped
+// and resumed, give the same edges.
+TEST(Builder, DeterministicAcrossThreadsAndResumable) {
+  Scene scene("table");
+  BuildSettings settings = default_settings(scene.robot);
+  settings.edges = 150;
+  settings.seed = 9;
+  auto build = [&](int threads, int stop_after_rounds) {
+    Bundle b = new_bundle(scene.robot, scene.env, settings);
+    BuildControl control;
+    control.threads = threads;
+    control.quiet = true;
+    int polls = 0;
+    control.stop_requested = [&] { return stop_after_rounds >= 0 && polls++ >= stop_after_rounds; };
+    if (build_bundle(scene.sim, settings, b, control) == BuildOutcome::Interrupted) {
+      EXPECT_FALSE(b.header.complete);
+      EXPECT_LT(b.size(), settings.edges);
+      control.stop_requested = nullptr;
+      EXPECT_EQ(build_bundle(scene.sim, settings, b, control), BuildOutcome::Complete);
+    }
+    EXPECT_TRUE(b.header.complete);
+    return b;
+  };
+  const Bundle one = build(1, -1), two = build(2, -1), resumed = build(2, 1);
+  for (const Bundle* other : {&two, &resumed}) {
+    ASSERT_EQ(other->size(), 150u);
+    EXPECT_EQ(one.q0, other->q0);
+    EXPECT_EQ(one.qf, other->qf);
+    EXPECT_EQ(one.knots, other->knots);
+    EXPECT_EQ(one.knot_offset, other->knot_offset);
+    EXPECT_EQ(one.sample_q, other->sample_q);
+    EXPECT_EQ(one.attempt, other->attempt);
+    EXPECT_EQ(one.header.attempts, other->header.attempts);
+    EXPECT_EQ(one.header.rejected, other->header.rejected);
+    EXPECT_EQ(one.header.simulated_seconds, other->header.simulated_seconds);
+  }
+  // Stored edges replay to their stored end states.
+  SimulatorWorkspace ws(scene.sim);
+  for (size_t k = 0; k < one.size(); k += 10) {
+    const JointVector q0 = Eigen::Map<const Eigen::VectorXd>(&one.q0[k * 7], 7);
+    const CommandProfile p{&one.knots[one.knot_offset[k] * 7],
+                           static_cast<int>(one.knot_offset[k + 1] - one.knot_offset[k]), 7,
+                           one.command_duration[k]};
+    const RolloutResult r = simulate(scene.sim, ws, q0, p);
+    ASSERT_TRUE(r.valid());
+    for (int i = 0; i < 7; ++i) EXPECT_EQ(r.qf[i], one.qf[k * 7 + i]);
+  }
+}
+
+}  // namespace
+}  // namespace lazyboe
