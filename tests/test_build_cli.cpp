@@ -607,7 +607,9 @@ void expect_bad_input(const BadCase& c, const std::string& dir_name) {
 TEST(BuildCli, BadInputIsOneLineAndWritesNothing) {
   const std::string outside = "-3:3,-0.3:0.7,-0.6:0.6,-2.6:-1.4,-0.6:0.6,1.3:2.5,0:1.6";
   const std::vector<BadCase> cases = {
-      {"edges 0", {"--out", "@OUT", "--edges", "0"}, {"--edges"}},
+      {"edges 0", {"--out", "@OUT", "--edges", "0"}, {"--edges", "> 0"}, true},
+      {"seed -3", {"--out", "@OUT", "--seed", "-3"}, {"--seed", ">= 0"}, true},
+      {"checkpoint -1", {"--out", "@OUT", "--checkpoint-seconds", "-1"}, {"--checkpoint-seconds"}, true},
       {"durations reversed", {"--out", "@OUT", "--min-duration", "0.8", "--max-duration", "0.5"}, {"--max-duration"}},
       {"region outside the limits", {"--out", "@OUT", "--region", outside}, {"--region", "joint 1", "2.897"}},
       {"region with 2 pairs", {"--out", "@OUT", "--region", "-1:1,-0.3:0.7"}, {"--region", "7"}},

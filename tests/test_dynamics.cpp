@@ -295,3 +295,29 @@ TEST(Dynamics, HotPathsDoNotAllocate) {
 
 }  // namespace
 }  // namespace lazyboe
+
+namespace lazyboe {
+namespace {
+
+// The simulator's shared pass gives the same gravity, mass matrix and accelerations as the
+// separate algorithms.
+TEST(Dynamics, SharedTermsMatchSeparateAlgorithms) {
+  const RobotModel& robot = test::panda();
+  RobotData shared(robot), separate(robot);
+  std::mt19937_64 rng(19);
+  for (int trial = 0; trial < 100; ++trial) {
+    const State s = random_state(robot, rng);
+    JointVector tau(7);
+    for (int i = 0; i < 7; ++i) tau[i] = std::uniform_real_distribution<double>(-1, 1)(rng) * robot.tau_max[i];
+    dynamics_terms(robot, shared, s.q, s.dq);
+    const JointVector g = gravity_torques(robot, separate, s.q);
+    EXPECT_LT((shared.gravity - g).norm(), 1e-12 * std::max(1.0, g.norm()));
+    EXPECT_LT((shared.M - mass_matrix(robot, separate, s.q)).norm(), 1e-14);
+    const JointVector a = forward_dynamics_from_terms(shared, tau);
+    const JointVector b = forward_dynamics(robot, separate, s.q, s.dq, tau);
+    EXPECT_LT((a - b).norm(), 1e-9 * std::max(1.0, b.norm()));
+  }
+}
+
+}  // namespace
+}  // namespace lazyboe

@@ -4,6 +4,8 @@
 #include <atomic>
 #include <cmath>
 #include <csignal>
+#include <ctime>
+#include <unistd.h>
 #include <cstdio>
 #include <filesystem>
 #include <sstream>
@@ -19,12 +21,25 @@ namespace {
 using namespace lazyboe;
 
 std::atomic<bool> g_stop{false};
+std::atomic<long> g_first_signal_ms{0};
 
+long monotonic_ms() {
+  timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);  // async-signal-safe
+  return ts.tv_sec * 1000L + ts.tv_nsec / 1000000L;
+}
+
+// The first SIGINT/SIGTERM asks for a checkpoint and a clean stop. A second one more than a
+// second later (a user pressing Ctrl-C again) ends the process at once; the last checkpoint on
+// disk stays valid. Duplicates within a second (a signal sent to the whole process group, as
+// `timeout` does) are ignored.
 void on_signal(int) {
-  g_stop = true;
-  // A second Ctrl-C ends the process at once; the last checkpoint on disk stays valid.
-  std::signal(SIGINT, SIG_DFL);
-  std::signal(SIGTERM, SIG_DFL);
+  const long now = monotonic_ms();
+  if (!g_stop.exchange(true)) {
+    g_first_signal_ms = now;
+  } else if (now - g_first_signal_ms > 1000) {
+    _exit(130);
+  }
 }
 
 // --region: "default" (the robot config's sampling_region), "limits" (the joint limits), a JSON
@@ -107,9 +122,9 @@ int main(int argc, char** argv) {
   app.add_option("--robot", robot_path, "Robot config (JSON)")->capture_default_str();
   app.add_option("--env", env_path, "Environment (JSON)")->capture_default_str();
   app.add_option("--out", out_path, "Bundle file to write (HDF5)");
-  app.add_option("--edges", s.edges, "Valid edges to generate")->capture_default_str();
-  app.add_option("--seed", s.seed, "Random seed")->capture_default_str();
-  app.add_option("--threads", control.threads, "Threads (0: all cores)")->capture_default_str();
+  app.add_option("--edges", s.edges, "Valid edges to generate")->capture_default_str()->check(whole_number(false));
+  app.add_option("--seed", s.seed, "Random seed")->capture_default_str()->check(whole_number(true));
+  app.add_option("--threads", control.threads, "Threads (0: all cores)")->capture_default_str()->check(whole_number(true));
   app.add_option("--region", region,
                  "Start-state box: default (robot config), limits, a JSON file, or lo:hi,... per joint")
       ->capture_default_str();
@@ -125,7 +140,7 @@ int main(int argc, char** argv) {
   app.add_option("--sample-interval", sample_interval, "Stored trajectory spacing, s (0: none)")->capture_default_str();
   app.add_option("--theta", s.design_theta, "Neighbourhood radius the bundle is designed for (rad)")->capture_default_str();
   app.add_option("--checkpoint-seconds", control.checkpoint_seconds, "Least time between checkpoints")
-      ->capture_default_str();
+      ->capture_default_str()->check(number_at_least_zero());
   app.add_flag("--resume", resume, "Continue an interrupted build in --out (to --edges)");
   app.add_flag("--force", force, "Overwrite an existing --out");
   app.add_flag("--quiet", control.quiet, "No progress output");
@@ -201,15 +216,19 @@ int main(int argc, char** argv) {
         fail("--edges", "the file already holds " + std::to_string(existing.size()) + " edges");
       }
       if (existing.size() == s.edges && existing.header.complete) {
-        std::fprintf(stderr, "lazyboe-build: %s is already complete with %zu edges\n", out_path.c_str(), existing.size());
+        if (!control.quiet) {
+          std::fprintf(stderr, "lazyboe-build: %s is already complete with %zu edges\n", out_path.c_str(), existing.size());
+        }
         return 0;
       }
       existing.header.target_edges = s.edges;
       existing.header.complete = false;
       existing.header.tool_version = LAZYBOE_VERSION;
       bundle = std::move(existing);
-      std::fprintf(stderr, "lazyboe-build: resuming %s at %zu of %llu edges\n", out_path.c_str(),
-                   bundle.size(), static_cast<unsigned long long>(s.edges));
+      if (!control.quiet) {
+        std::fprintf(stderr, "lazyboe-build: resuming %s at %zu of %llu edges\n", out_path.c_str(),
+                     bundle.size(), static_cast<unsigned long long>(s.edges));
+      }
     }
 
     std::signal(SIGINT, on_signal);

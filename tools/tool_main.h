@@ -5,6 +5,7 @@
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <exception>
+#include <cstdlib>
 #include <string>
 
 #include "common/error.h"
@@ -16,6 +17,29 @@ inline void one_line_cli_errors(CLI::App& app, const std::string& tool) {
   app.failure_message([tool](const CLI::App*, const CLI::Error& e) {
     return tool + ": error: " + e.what() + " (see --help)\n";
   });
+}
+
+// Option validators with plain messages ("must be a whole number > 0").
+inline CLI::Validator whole_number(bool allow_zero) {
+  return CLI::Validator(
+      [allow_zero](std::string& text) -> std::string {
+        const bool digits = !text.empty() && text.find_first_not_of("0123456789") == std::string::npos;
+        if (!digits || text.size() > 19) return allow_zero ? "must be a whole number >= 0" : "must be a whole number > 0";
+        if (!allow_zero && std::stoull(text) == 0) return "must be a whole number > 0";
+        return "";
+      },
+      allow_zero ? "INT>=0" : "INT>0");
+}
+
+inline CLI::Validator number_at_least_zero() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        char* end = nullptr;
+        const double v = std::strtod(text.c_str(), &end);
+        if (text.empty() || *end != '\0' || !(v >= 0) || v > 1e300) return "must be a number >= 0";
+        return "";
+      },
+      "NUM>=0");
 }
 
 template <typename Body>

@@ -163,6 +163,31 @@ const JointVector& forward_dynamics(const RobotModel& model, RobotData& data,
   return data.ddq;
 }
 
+void dynamics_terms(const RobotModel& model, RobotData& data, const JointVectorRef& q,
+                    const JointVectorRef& dq) {
+  update_joint_poses(model, data, q);
+  crba_from_poses(model, data);
+  data.llt.compute(data.M);
+  // Gravity torque of joint i: the weight of everything it carries, at the subtree's centre of
+  // mass (data.composite, in body i's frame), about the joint axis.
+  Eigen::Vector3d g = model.gravity;  // gravity in the current body frame
+  for (int i = 0; i < model.dof; ++i) {
+    const Joint& j = model.joints[i];
+    g = data.joint_pose[i].R.transpose() * g;
+    const BodyInertia& c = data.composite[i];
+    data.gravity[i] = j.type == JointType::Revolute ? -j.axis.dot(c.com.cross(c.mass * g))
+                                                    : -j.axis.dot(c.mass * g);
+  }
+  data.ddq.setZero();
+  rnea_from_poses(model, data, dq, data.ddq, false, true);
+  data.h = data.tau;
+}
+
+const JointVector& forward_dynamics_from_terms(RobotData& data, const JointVectorRef& tau) {
+  data.ddq = data.llt.solve(tau - data.gravity - data.h);
+  return data.ddq;
+}
+
 double kinetic_energy(const RobotModel& model, RobotData& data, const JointVectorRef& q,
                       const JointVectorRef& dq) {
   const JointMatrix& M = mass_matrix(model, data, q);

@@ -34,6 +34,15 @@ const JointVector& forward_dynamics(const RobotModel& model, RobotData& data,
                                     const JointVectorRef& q, const JointVectorRef& dq,
                                     const JointVectorRef& tau);
 
+// Everything forward dynamics needs at one state, sharing one pass of joint poses: the mass
+// matrix and its Cholesky factor (data.M, data.llt), gravity torques from the composite bodies
+// (data.gravity), and the velocity terms C(q, dq) dq + tau_f(dq) (data.h). A simulator tick
+// then gets ddq for its controller torque from forward_dynamics_from_terms without a second
+// pass.
+void dynamics_terms(const RobotModel& model, RobotData& data, const JointVectorRef& q,
+                    const JointVectorRef& dq);
+const JointVector& forward_dynamics_from_terms(RobotData& data, const JointVectorRef& tau);
+
 double kinetic_energy(const RobotModel& model, RobotData& data, const JointVectorRef& q,
                       const JointVectorRef& dq);
 double potential_energy(const RobotModel& model, RobotData& data, const JointVectorRef& q);

@@ -144,8 +144,11 @@ RolloutResult simulate(const Simulator& sim, SimulatorWorkspace& ws, const Joint
     const double t = tick * dt;
     evaluate_command(profile, t, v_cmd.data(), a_cmd.data(), offset.data());
 
+    // Mass matrix, gravity and velocity terms at this tick's state, shared by the controller
+    // and the first integration step.
+    dynamics_terms(robot, rd, q, dq);
     // Joint controller: gravity, friction and inertia feed-forward, P on the velocity error.
-    tau = gravity_torques(robot, rd, q);
+    tau = rd.gravity;
     for (int i = 0; i < n; ++i) {
       tau[i] += gains.ka[i] * a_cmd[i] + gains.kv[i] * (v_cmd[i] - dq[i]);
       if (gains.friction_feedforward) tau[i] += friction_torque(robot.joints[i].friction, v_cmd[i]);
@@ -157,8 +160,7 @@ RolloutResult simulate(const Simulator& sim, SimulatorWorkspace& ws, const Joint
     // At rest after the command: stop once the next edge could start without a jump in
     // velocity, acceleration (jerk) or torque (the next edge starts from holding torque g(q)).
     if (t >= profile.duration && (dq.array().abs() <= sim.options.settle_velocity).all()) {
-      const JointVector& hold = gravity_torques(robot, rd, q);
-      if (within(ddq_prev, ddq_step_max) && within(tau - hold, tau_rate_max)) {
+      if (within(ddq_prev, ddq_step_max) && within(tau - rd.gravity, tau_rate_max)) {
         if (moved > 0) {
           const RolloutStatus c = collision_status(sim, ws, q, result.collision_checks);
           if (c != RolloutStatus::Valid) return finish(c, tick);
@@ -174,14 +176,14 @@ RolloutResult simulate(const Simulator& sim, SimulatorWorkspace& ws, const Joint
     q_prev = q;
     for (int sub = 0; sub < sim.options.substeps; ++sub) {
       if (sim.options.integrator == Integrator::SemiImplicitEuler) {
-        k1v = forward_dynamics(robot, rd, q, dq, tau);
+        k1v = sub == 0 ? forward_dynamics_from_terms(rd, tau) : forward_dynamics(robot, rd, q, dq, tau);
         if (sub == 0) ddq = k1v;
         dq += h * k1v;
         q += h * dq;
         continue;
       }
       k1q = dq;
-      k1v = forward_dynamics(robot, rd, q, dq, tau);
+      k1v = sub == 0 ? forward_dynamics_from_terms(rd, tau) : forward_dynamics(robot, rd, q, dq, tau);
       if (sub == 0) ddq = k1v;
       k2q = dq + 0.5 * h * k1v;
       k2v = forward_dynamics(robot, rd, q + 0.5 * h * k1q, k2q, tau);
