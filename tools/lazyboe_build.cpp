@@ -1,11 +1,7 @@
 // lazyboe-build: generate the edge bundle (valid random rollouts of the robot's dynamics) in
 // parallel and store it in HDF5; or --inspect an existing bundle.
 #include <algorithm>
-#include <atomic>
 #include <cmath>
-#include <csignal>
-#include <ctime>
-#include <unistd.h>
 #include <cstdio>
 #include <filesystem>
 #include <sstream>
@@ -19,28 +15,6 @@
 namespace {
 
 using namespace lazyboe;
-
-std::atomic<bool> g_stop{false};
-std::atomic<long> g_first_signal_ms{0};
-
-long monotonic_ms() {
-  timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);  // async-signal-safe
-  return ts.tv_sec * 1000L + ts.tv_nsec / 1000000L;
-}
-
-// The first SIGINT/SIGTERM asks for a checkpoint and a clean stop. A second one more than a
-// second later (a user pressing Ctrl-C again) ends the process at once; the last checkpoint on
-// disk stays valid. Duplicates within a second (a signal sent to the whole process group, as
-// `timeout` does) are ignored.
-void on_signal(int) {
-  const long now = monotonic_ms();
-  if (!g_stop.exchange(true)) {
-    g_first_signal_ms = now;
-  } else if (now - g_first_signal_ms > 1000) {
-    _exit(130);
-  }
-}
 
 // --region: "default" (the robot config's sampling_region), "limits" (the joint limits), a JSON
 // file {"lower": [...], "upper": [...]}, or inline "lo1:hi1,lo2:hi2,...".
@@ -224,6 +198,14 @@ int main(int argc, char** argv) {
       existing.header.target_edges = s.edges;
       existing.header.complete = false;
       existing.header.tool_version = LAZYBOE_VERSION;
+      if (existing.perturbation.present) {
+        // New edges have no perturbation counts: the analysis has to be run again.
+        existing.perturbation = Perturbation{};
+        if (!control.quiet) {
+          std::fprintf(stderr, "lazyboe-build: the perturbation analysis in %s is dropped; run lazyboe-perturb again\n",
+                       out_path.c_str());
+        }
+      }
       bundle = std::move(existing);
       if (!control.quiet) {
         std::fprintf(stderr, "lazyboe-build: resuming %s at %zu of %llu edges\n", out_path.c_str(),
@@ -231,9 +213,8 @@ int main(int argc, char** argv) {
       }
     }
 
-    std::signal(SIGINT, on_signal);
-    std::signal(SIGTERM, on_signal);
-    control.stop_requested = [] { return g_stop.load(); };
+    install_stop_handlers();
+    control.stop_requested = stop_requested;
     control.save_checkpoint = [&](const Bundle& b) { write_bundle(out_path, b); };
     const BuildOutcome outcome = build_bundle(sim, s, bundle, control);
     if (!control.quiet) print_summary(bundle);

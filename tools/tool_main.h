@@ -3,7 +3,12 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
+#include <unistd.h>
+
+#include <atomic>
+#include <csignal>
 #include <cstdio>
+#include <ctime>
 #include <exception>
 #include <cstdlib>
 #include <string>
@@ -41,6 +46,34 @@ inline CLI::Validator number_at_least_zero() {
       },
       "NUM>=0");
 }
+
+// SIGINT/SIGTERM handling for long jobs. The first signal asks for a checkpoint and a clean
+// stop (stop_requested() turns true). A second one more than a second later (a user pressing
+// Ctrl-C again) ends the process at once; the last checkpoint on disk stays valid. Duplicates
+// within a second (a signal sent to the whole process group, as `timeout` does) are ignored.
+namespace detail {
+inline std::atomic<bool> g_stop{false};
+inline std::atomic<long> g_first_signal_ms{0};
+inline long monotonic_ms() {
+  timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);  // async-signal-safe
+  return ts.tv_sec * 1000L + ts.tv_nsec / 1000000L;
+}
+inline void on_stop_signal(int) {
+  const long now = monotonic_ms();
+  if (!g_stop.exchange(true)) {
+    g_first_signal_ms = now;
+  } else if (now - g_first_signal_ms > 1000) {
+    _exit(130);
+  }
+}
+}  // namespace detail
+
+inline void install_stop_handlers() {
+  std::signal(SIGINT, detail::on_stop_signal);
+  std::signal(SIGTERM, detail::on_stop_signal);
+}
+inline bool stop_requested() { return detail::g_stop.load(); }
 
 template <typename Body>
 int run_tool(const char* tool, Body&& body) {

@@ -42,8 +42,29 @@ struct BundleHeader {
   double wall_seconds = 0;
 };
 
+// The perturbation analysis of lazyboe-perturb (paper, Methods C): per edge, counts over
+// perturbations of its start state by up to theta, and the probabilities derived from them.
+struct Perturbation {
+  bool present = false;
+  bool complete = false;       // every edge has `perturbations` done
+  double theta = 0;            // perturbation radius; lazy threshold theta/2
+  uint64_t perturbations = 0;  // p, the target per edge
+  uint64_t seed = 0;
+  double wall_seconds = 0;
+  double simulated_seconds = 0;
+  // Per edge (N).
+  std::vector<uint64_t> done;       // perturbations simulated so far
+  std::vector<uint64_t> valid;      // of them, rollouts passing every check
+  std::vector<uint64_t> lazy;       // of the valid ones, end-state error < theta/2
+  std::vector<uint64_t> collision;  // rollouts that failed the collision check
+  std::vector<double> max_error;    // over the valid ones (NaN when none), rad
+  std::vector<double> p_lazy_prop;  // lazy / valid (0 when no perturbation was valid)
+  std::vector<double> p_collision;  // collision / done
+};
+
 struct Bundle {
   BundleHeader header;
+  Perturbation perturbation;  // empty until lazyboe-perturb runs
   // Per edge (N edges), row-major with dof columns where two-dimensional.
   std::vector<double> q0, qf;             // N x dof: start and end state (at rest)
   std::vector<double> duration;           // N: simulated duration including settling, s

@@ -203,6 +203,17 @@ void check_bundle(const Bundle& b, const std::string& where) {
     fail(where, "bundle.sample_q: " + str(b.sample_q.size()) + " values, not a multiple of dof = " +
                     str(dof));
   check_size(where, "sample_dq", b.sample_dq.size(), b.sample_q.size(), "sample_q.size()");
+  if (b.perturbation.present) {
+    const Perturbation& p = b.perturbation;
+    const std::string e = "edges (duration.size())";
+    check_size(where, "perturbation.done", p.done.size(), n, e);
+    check_size(where, "perturbation.valid", p.valid.size(), n, e);
+    check_size(where, "perturbation.lazy", p.lazy.size(), n, e);
+    check_size(where, "perturbation.collision", p.collision.size(), n, e);
+    check_size(where, "perturbation.max_error", p.max_error.size(), n, e);
+    check_size(where, "perturbation.p_lazy_prop", p.p_lazy_prop.size(), n, e);
+    check_size(where, "perturbation.p_collision", p.p_collision.size(), n, e);
+  }
   check_offsets(where, "bundle.knot_offset", b.knot_offset, b.knots.size() / dof, "bundle.knots");
   check_offsets(where, "bundle.sample_offset", b.sample_offset, b.sample_q.size() / dof,
                 "bundle.sample_q");
@@ -230,6 +241,25 @@ void write_bundle(const std::string& path, const Bundle& b) {
       h5::write_dataset(tmp, file, ds::knots, b.knots, {k, dof});
       h5::write_dataset(tmp, file, ds::sample_q, b.sample_q, {s, dof});
       h5::write_dataset(tmp, file, ds::sample_dq, b.sample_dq, {s, dof});
+      if (b.perturbation.present) {
+        const Perturbation& p = b.perturbation;
+        h5::Group g = h5::create_group(tmp, file, ds::perturbation);
+        h5::write_attr_bool(tmp, g, "complete", p.complete);
+        h5::write_attr_f64(tmp, g, "theta", p.theta);
+        h5::write_attr_u64(tmp, g, "perturbations", p.perturbations);
+        h5::write_attr_u64(tmp, g, "seed", p.seed);
+        h5::write_attr_f64(tmp, g, "wall_seconds", p.wall_seconds);
+        h5::write_attr_f64(tmp, g, "simulated_seconds", p.simulated_seconds);
+        h5::write_attr_string(tmp, g, "distribution",
+                              "start + d, d = r u: u uniform on the unit sphere, r uniform in (0, theta]");
+        h5::write_dataset(tmp, file, ds::pert_done, p.done, {n});
+        h5::write_dataset(tmp, file, ds::pert_valid, p.valid, {n});
+        h5::write_dataset(tmp, file, ds::pert_lazy, p.lazy, {n});
+        h5::write_dataset(tmp, file, ds::pert_collision, p.collision, {n});
+        h5::write_dataset(tmp, file, ds::pert_max_error, p.max_error, {n});
+        h5::write_dataset(tmp, file, ds::p_lazy_prop, p.p_lazy_prop, {n});
+        h5::write_dataset(tmp, file, ds::p_collision, p.p_collision, {n});
+      }
       h5::close_file(tmp, file);
     }
     fsync_path(tmp, false);
@@ -246,6 +276,12 @@ void write_bundle(const std::string& path, const Bundle& b) {
     fsync_path(dir.empty() ? "." : dir, true);
   } catch (const Error&) {
   }
+}
+
+void require_complete(const BundleHeader& h, const std::string& path) {
+  if (h.complete) return;
+  fail(path, "incomplete bundle (" + str(h.valid) + " of " + str(h.target_edges) +
+                 " edges): finish it with: lazyboe-build --resume --out " + path);
 }
 
 BundleHeader read_bundle_header(const std::string& path, uint64_t* edges) {
@@ -285,6 +321,26 @@ Bundle read_bundle(const std::string& path) {
   b.knots = h5::read_dataset<double>(path, file, ds::knots, {k, dof});
   b.sample_q = h5::read_dataset<float>(path, file, ds::sample_q, {s, dof});
   b.sample_dq = h5::read_dataset<float>(path, file, ds::sample_dq, {s, dof});
+  if (h5::exists(file, ds::perturbation)) {
+    Perturbation& p = b.perturbation;
+    h5::Group g(H5Gopen2(file, ds::perturbation, H5P_DEFAULT));
+    if (!g.valid()) fail(path, std::string(ds::perturbation) + ": cannot open group");
+    const std::string where = path;
+    p.present = true;
+    p.complete = h5::read_attr_bool(where, g, "complete");
+    p.theta = h5::read_attr_f64(where, g, "theta");
+    p.perturbations = h5::read_attr_u64(where, g, "perturbations");
+    p.seed = h5::read_attr_u64(where, g, "seed");
+    p.wall_seconds = h5::read_attr_f64(where, g, "wall_seconds");
+    p.simulated_seconds = h5::read_attr_f64(where, g, "simulated_seconds");
+    p.done = h5::read_dataset<uint64_t>(path, file, ds::pert_done, {n});
+    p.valid = h5::read_dataset<uint64_t>(path, file, ds::pert_valid, {n});
+    p.lazy = h5::read_dataset<uint64_t>(path, file, ds::pert_lazy, {n});
+    p.collision = h5::read_dataset<uint64_t>(path, file, ds::pert_collision, {n});
+    p.max_error = h5::read_dataset<double>(path, file, ds::pert_max_error, {n});
+    p.p_lazy_prop = h5::read_dataset<double>(path, file, ds::p_lazy_prop, {n});
+    p.p_collision = h5::read_dataset<double>(path, file, ds::p_collision, {n});
+  }
   return b;
 }
 

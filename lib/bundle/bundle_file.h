@@ -29,6 +29,14 @@ constexpr const char* sample_offset = "/edges/sample_offset";        // N+1 u64
 constexpr const char* knots = "/controls/knots";                     // K x dof f64
 constexpr const char* sample_q = "/trajectory/q";                    // S x dof f32
 constexpr const char* sample_dq = "/trajectory/dq";                  // S x dof f32
+constexpr const char* perturbation = "/perturbation";                // group, attributes
+constexpr const char* pert_done = "/perturbation/done";              // N u64
+constexpr const char* pert_valid = "/perturbation/valid";            // N u64
+constexpr const char* pert_lazy = "/perturbation/lazy";              // N u64
+constexpr const char* pert_collision = "/perturbation/collision";    // N u64
+constexpr const char* pert_max_error = "/perturbation/max_error";    // N f64
+constexpr const char* p_lazy_prop = "/perturbation/p_lazy_prop";     // N f64
+constexpr const char* p_collision = "/perturbation/p_collision";     // N f64
 }  // namespace bundle_dataset
 
 // Checks the in-memory bundle is self-consistent: schema_version 1, dof >= 1, region bounds of
@@ -48,6 +56,10 @@ Bundle read_bundle(const std::string& path);
 // Reads only the root attributes (cheap; no dataset is read). When `edges` is given it receives
 // the number of edges N (the root attribute `edges`).
 BundleHeader read_bundle_header(const std::string& path, uint64_t* edges = nullptr);
+
+// Other tools than lazyboe-build accept only a finished bundle: this throws, saying how to
+// finish it, for an incomplete one.
+void require_complete(const BundleHeader& header, const std::string& path);
 
 // Where a dataset's raw bytes are, for memory-mapping. When contiguous and bytes > 0, the
 // little-endian elements lie row-major at [file_offset, file_offset + bytes) of the file.

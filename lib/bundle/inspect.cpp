@@ -32,6 +32,48 @@ std::vector<double> neighbour_counts(const Bundle& b, double theta, int points, 
   return counts;
 }
 
+void print_perturbation_summary(const Bundle& b, std::FILE* out) {
+  const Perturbation& p = b.perturbation;
+  if (!p.present) {
+    std::fprintf(out, "perturbation analysis: none (run lazyboe-perturb)\n");
+    return;
+  }
+  const size_t N = b.size();
+  uint64_t done = 0, valid = 0, collision = 0, finished = 0;
+  std::vector<double> select(N), errors;
+  size_t usable = 0, never = 0;
+  for (size_t e = 0; e < N; ++e) {
+    done += p.done[e];
+    valid += p.valid[e];
+    collision += p.collision[e];
+    finished += p.done[e] >= p.perturbations;
+    select[e] = (1 - p.p_collision[e]) * p.p_lazy_prop[e];
+    usable += select[e] >= 0.5;
+    never += select[e] == 0;
+    if (p.valid[e]) errors.push_back(p.max_error[e]);
+  }
+  std::fprintf(out, "perturbation analysis: theta %g rad, %llu perturbations per edge, seed %llu, %s\n", p.theta,
+               static_cast<unsigned long long>(p.perturbations), static_cast<unsigned long long>(p.seed),
+               p.complete ? "complete" : "INCOMPLETE (run lazyboe-perturb again to continue)");
+  std::fprintf(out, "  edges done %llu of %zu; rollouts %llu: valid %.1f%%, collided %.1f%%; simulated %.0f s in %.1f s wall\n",
+               static_cast<unsigned long long>(finished), N, static_cast<unsigned long long>(done),
+               done ? 100.0 * valid / done : 0.0, done ? 100.0 * collision / done : 0.0,
+               p.simulated_seconds, p.wall_seconds);
+  if (N == 0) return;
+  const Quantiles ql = quantiles(p.p_lazy_prop), qc = quantiles(p.p_collision), qs = quantiles(select);
+  std::fprintf(out, "P_lazy_prop: mean %.3f, median %.3f\n", ql.mean, ql.median);
+  std::fputs(text_histogram(p.p_lazy_prop, 0, 1, 10).c_str(), out);
+  std::fprintf(out, "P_collision: mean %.3f, median %.3f\n", qc.mean, qc.median);
+  std::fputs(text_histogram(p.p_collision, 0, 1, 10).c_str(), out);
+  if (!errors.empty()) {
+    const Quantiles qe = quantiles(errors);
+    std::fprintf(out, "max end-state error per edge (rad): median %.3f, 90th percentile %.3f, max %.3f (theta/2 = %.3f)\n",
+                 qe.median, qe.p90, qe.max, p.theta / 2);
+  }
+  std::fprintf(out, "P_select = (1 - P_collision) P_lazy_prop: mean %.3f; %.1f%% of edges >= 0.5 (usable for lazy propagation), %.1f%% never taken lazily (0)\n",
+               qs.mean, 100.0 * usable / N, 100.0 * never / N);
+}
+
 void print_inspection(const std::string& path, std::FILE* out) {
   const Bundle b = read_bundle(path);
   const BundleHeader& h = b.header;
@@ -90,6 +132,8 @@ void print_inspection(const std::string& path, std::FILE* out) {
   std::fprintf(out, "edge starts within theta = %g of 500 random region points: mean %.1f, median %.0f, "
                     "10th percentile %.0f, none for %.1f%% of points\n",
                h.design_theta, qn.mean, qn.median, qn.p10, 100.0 * zero / counts.size());
+  std::fputs("\n", out);
+  print_perturbation_summary(b, out);
 }
 
 }  // namespace lazyboe

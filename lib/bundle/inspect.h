@@ -11,6 +11,10 @@ namespace lazyboe {
 
 void print_inspection(const std::string& path, std::FILE* out);
 
+// The perturbation analysis of a bundle: settings, distributions of both probabilities
+// (text histograms) and the share of edges usable for lazy propagation.
+void print_perturbation_summary(const Bundle& bundle, std::FILE* out);
+
 // Edge starts within `theta` (Euclidean, joint space) of random points of the sampling region:
 // the design check that a bundle holds enough neighbours for the planner.
 std::vector<double> neighbour_counts(const Bundle& bundle, double theta, int points, uint64_t seed);

@@ -1,0 +1,170 @@
+#include "bundle/perturbation.h"
+
+#include <omp.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+#include "common/error.h"
+#include "common/progress.h"
+#include "sim/random.h"
+
+namespace lazyboe {
+namespace {
+
+// Keeps perturbation streams apart from the build's attempt streams for the same seed.
+constexpr uint64_t kPerturbSalt = 0x7065727475726221ULL;  // "perturb!"
+
+void set_probabilities(Perturbation& p, size_t e) {
+  p.p_lazy_prop[e] = p.valid[e] ? static_cast<double>(p.lazy[e]) / p.valid[e] : 0.0;
+  p.p_collision[e] = p.done[e] ? static_cast<double>(p.collision[e]) / p.done[e] : 0.0;
+}
+
+}  // namespace
+
+JointVector perturbation_offset(const PerturbSettings& s, int dof, uint64_t edge, uint64_t j) {
+  Random rng(s.seed ^ kPerturbSalt, (edge << 24) ^ j);
+  JointVector d(dof);
+  double norm = 0;
+  do {
+    for (int i = 0; i < dof; ++i) d[i] = rng.normal();
+    norm = d.norm();
+  } while (norm < 1e-12);
+  const double r = s.theta * (1.0 - rng.uniform());  // in (0, theta]
+  return d * (r / norm);
+}
+
+void perturb_edge(const Simulator& sim, SimulatorWorkspace& ws, const Bundle& b, size_t e,
+                  const PerturbSettings& s, EdgePerturbationCounts& c) {
+  const int n = b.dof();
+  const JointVector q0 = Eigen::Map<const Eigen::VectorXd>(&b.q0[e * n], n);
+  const JointVector qf = Eigen::Map<const Eigen::VectorXd>(&b.qf[e * n], n);
+  const CommandProfile profile{&b.knots[b.knot_offset[e] * n],
+                               static_cast<int>(b.knot_offset[e + 1] - b.knot_offset[e]), n,
+                               b.command_duration[e]};
+  for (uint64_t j = c.done; j < s.perturbations; ++j) {
+    const JointVector start = q0 + perturbation_offset(s, n, e, j);
+    const RolloutResult r = simulate(sim, ws, start, profile);
+    ++c.done;
+    c.simulated_seconds += r.duration;
+    if (r.status == RolloutStatus::SelfCollision || r.status == RolloutStatus::EnvCollision) {
+      ++c.collision;
+    } else if (r.valid()) {
+      const double error = (r.qf - qf).norm();
+      c.max_error = c.valid ? std::max(c.max_error, error) : error;
+      ++c.valid;
+      if (error < s.theta / 2) ++c.lazy;
+    }
+  }
+}
+
+void prepare_perturbation(Bundle& b, const PerturbSettings& s, bool replace, const std::string& path) {
+  Perturbation& p = b.perturbation;
+  const size_t n = b.size();
+  if (p.present && !replace) {
+    if (p.theta != s.theta) {
+      fail(path, "holds a perturbation analysis for theta " + std::to_string(p.theta) +
+                     "; use --replace to discard it and start one for theta " + std::to_string(s.theta));
+    }
+    if (p.seed != s.seed) {
+      fail(path, "holds a perturbation analysis with seed " + std::to_string(p.seed) +
+                     "; use the same --seed to extend it, or --replace to start over");
+    }
+    if (s.perturbations < p.perturbations) {
+      fail(path, "holds " + std::to_string(p.perturbations) +
+                     " perturbations per edge already; use --replace to start over with fewer");
+    }
+    p.perturbations = s.perturbations;
+    p.complete = std::all_of(p.done.begin(), p.done.end(), [&](uint64_t d) { return d >= s.perturbations; });
+    return;
+  }
+  p = Perturbation{};
+  p.present = true;
+  p.theta = s.theta;
+  p.perturbations = s.perturbations;
+  p.seed = s.seed;
+  p.done.assign(n, 0);
+  p.valid.assign(n, 0);
+  p.lazy.assign(n, 0);
+  p.collision.assign(n, 0);
+  p.max_error.assign(n, std::numeric_limits<double>::quiet_NaN());
+  p.p_lazy_prop.assign(n, 0.0);
+  p.p_collision.assign(n, 0.0);
+  p.complete = n == 0;
+}
+
+PerturbOutcome run_perturbation(const Simulator& sim, Bundle& b, const PerturbSettings& s,
+                                const PerturbControl& control) {
+  Perturbation& p = b.perturbation;
+  const size_t n = b.size();
+  const int threads = control.threads > 0 ? control.threads : omp_get_max_threads();
+  std::vector<SimulatorWorkspace> workspaces;
+  workspaces.reserve(threads);
+  for (int t = 0; t < threads; ++t) workspaces.emplace_back(sim);
+
+  // Edges still short of p perturbations, in edge order.
+  std::vector<size_t> pending;
+  for (size_t e = 0; e < n; ++e) {
+    if (p.done[e] < s.perturbations) pending.push_back(e);
+  }
+  Progress progress("lazyboe-perturb", n, control.quiet);
+  const double wall_before = p.wall_seconds;
+  auto last_checkpoint = std::chrono::steady_clock::now();
+  double checkpoint_cost = 0;
+  auto save = [&](bool complete) {
+    p.complete = complete;
+    p.wall_seconds = wall_before + progress.elapsed();
+    const auto t0 = std::chrono::steady_clock::now();
+    if (control.save_checkpoint) control.save_checkpoint(b);
+    last_checkpoint = std::chrono::steady_clock::now();
+    checkpoint_cost = std::chrono::duration<double>(last_checkpoint - t0).count();
+  };
+  size_t finished = n - pending.size();
+  const size_t round = std::max<size_t>(16, 8 * static_cast<size_t>(threads));
+  std::vector<EdgePerturbationCounts> counts(round);
+  progress.update(finished);
+  for (size_t start = 0; start < pending.size(); start += round) {
+    if (control.stop_requested && control.stop_requested()) {
+      progress.finish();
+      save(false);
+      return PerturbOutcome::Interrupted;
+    }
+    const size_t count = std::min(round, pending.size() - start);
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 1)
+    for (long k = 0; k < static_cast<long>(count); ++k) {
+      const size_t e = pending[start + k];
+      EdgePerturbationCounts& c = counts[k];
+      c.done = p.done[e];
+      c.valid = p.valid[e];
+      c.lazy = p.lazy[e];
+      c.collision = p.collision[e];
+      c.max_error = p.valid[e] ? p.max_error[e] : 0.0;
+      c.simulated_seconds = 0;
+      perturb_edge(sim, workspaces[omp_get_thread_num()], b, e, s, c);
+    }
+    for (size_t k = 0; k < count; ++k) {
+      const size_t e = pending[start + k];
+      const EdgePerturbationCounts& c = counts[k];
+      p.done[e] = c.done;
+      p.valid[e] = c.valid;
+      p.lazy[e] = c.lazy;
+      p.collision[e] = c.collision;
+      p.max_error[e] = c.valid ? c.max_error : std::numeric_limits<double>::quiet_NaN();
+      p.simulated_seconds += c.simulated_seconds;
+      set_probabilities(p, e);
+    }
+    finished += count;
+    progress.update(finished);
+    const double since =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - last_checkpoint).count();
+    if (finished < n && since >= std::max(control.checkpoint_seconds, 10 * checkpoint_cost)) save(false);
+  }
+  progress.finish();
+  save(true);
+  return PerturbOutcome::Complete;
+}
+
+}  // namespace lazyboe

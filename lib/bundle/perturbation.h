@@ -1,0 +1,57 @@
+// The perturbation analysis (paper, Methods C): for every edge, p perturbed copies of its start
+// state re-simulated with the edge's own command by the shared Simulator. A perturbation is
+// d = r u with u uniform on the unit sphere and r uniform in (0, theta], so |d| < theta/2 for
+// half of them. Per edge:
+//   P_lazy_prop = (valid rollouts ending within theta/2 of the stored end state) / (valid ones)
+//                 (0 when none is valid: such an edge is never taken lazily)
+//   P_collision = (rollouts failing the collision check) / p
+// Perturbation j of edge i draws only from the stream (seed, i, j): any thread count gives the
+// same numbers, and raising p later adds perturbations p_old..p_new-1 to the same counts.
+#pragma once
+
+#include <functional>
+
+#include "bundle/bundle.h"
+#include "sim/simulator.h"
+
+namespace lazyboe {
+
+struct PerturbSettings {
+  double theta = 0.35;
+  uint64_t perturbations = 16;
+  uint64_t seed = 1;
+};
+
+struct PerturbControl {
+  int threads = 0;
+  double checkpoint_seconds = 10;
+  bool quiet = false;
+  std::function<bool()> stop_requested;
+  std::function<void(const Bundle&)> save_checkpoint;
+};
+
+// Draws perturbation j of edge `edge` (norm in (0, theta]).
+JointVector perturbation_offset(const PerturbSettings& settings, int dof, uint64_t edge, uint64_t j);
+
+struct EdgePerturbationCounts {
+  uint64_t done = 0, valid = 0, lazy = 0, collision = 0;
+  double max_error = 0;  // valid > 0 only
+  double simulated_seconds = 0;
+};
+
+// Runs perturbations [counts.done, settings.perturbations) of one edge, adding to `counts`.
+void perturb_edge(const Simulator& sim, SimulatorWorkspace& ws, const Bundle& bundle, size_t edge,
+                  const PerturbSettings& settings, EdgePerturbationCounts& counts);
+
+// Sets up bundle.perturbation for `settings`: keeps the existing counts when theta and seed
+// match and p does not shrink (they are extended), starts afresh when `replace` is set, and
+// refuses otherwise with a message naming the difference.
+void prepare_perturbation(Bundle& bundle, const PerturbSettings& settings, bool replace,
+                          const std::string& path);
+
+enum class PerturbOutcome { Complete, Interrupted };
+
+PerturbOutcome run_perturbation(const Simulator& sim, Bundle& bundle, const PerturbSettings& settings,
+                                const PerturbControl& control);
+
+}  // namespace lazyboe
