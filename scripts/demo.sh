@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
-# The main job on the bundled defaults: the robot model at work, then a small edge bundle built
-# on the default environment (table.json) and inspected. Later stages (perturbation analysis,
-# planning) join here as they are built.
+# The main job on the bundled defaults: the robot model at work, a small edge bundle built on the
+# default environment (table.json) and inspected, and its perturbation analysis. Planning joins
+# here when it is built.
 set -euo pipefail
 build=${1:-build}
 bin="$build/bin"
@@ -19,9 +19,12 @@ paste -d' ' <(cut -d, -f1-7 data/examples/states.csv | sed 's/^/     q: /') <(se
 echo "   collision checks on table.json of data/examples/configs.csv:"
 paste -d, data/examples/configs.csv "$out/check.csv" | column -t -s, | sed 's/^/     /'
 echo
-echo "== 2. Edge bundle: 3000 valid rollouts of the Panda's dynamics on table.json"
-"$bin/lazyboe-build" --out "$out/bundle.h5" --edges 3000 --seed 1 --force
+echo "== 2. Edge bundle: 2000 valid rollouts of the Panda's dynamics on table.json"
+"$bin/lazyboe-build" --out "$out/bundle.h5" --edges 2000 --seed 1 --force
 echo
 "$bin/lazyboe-build" --inspect "$out/bundle.h5" | sed -n '1,12p;/edge displacement/,/^coverage/p;/within theta/p' | grep -v '^coverage'
+echo
+echo "== 3. Perturbation analysis: 8 perturbed re-simulations per edge"
+"$bin/lazyboe-perturb" --bundle "$out/bundle.h5" --perturbations 8
 echo
 echo "demo: done (outputs in $out/)"
