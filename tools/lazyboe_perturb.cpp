@@ -86,7 +86,7 @@ int main(int argc, char** argv) {
     const PerturbOutcome outcome = run_perturbation(sim, bundle, s, control);
     if (!control.quiet) print_perturbation_summary(bundle, stdout);
     if (outcome == PerturbOutcome::Interrupted) {
-      std::fprintf(stderr, "lazyboe-perturb: interrupted; the completed edges are saved in %s. Continue with: lazyboe-perturb --bundle %s --theta %g --perturbations %llu --seed %llu\n",
+      std::fprintf(stderr, "lazyboe-perturb: interrupted; the completed edges are saved in %s. Continue with: lazyboe-perturb --bundle %s --theta %.17g --perturbations %llu --seed %llu\n",
                    bundle_path.c_str(), bundle_path.c_str(), s.theta,
                    static_cast<unsigned long long>(s.perturbations), static_cast<unsigned long long>(s.seed));
       return 130;

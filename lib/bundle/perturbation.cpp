@@ -15,6 +15,12 @@
 namespace lazyboe {
 namespace {
 
+std::string exact(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
+}
+
 // Keeps perturbation streams apart from the build's attempt streams for the same seed.
 constexpr uint64_t kPerturbSalt = 0x7065727475726221ULL;  // "perturb!"
 
@@ -66,8 +72,8 @@ void prepare_perturbation(Bundle& b, const PerturbSettings& s, bool replace, con
   const size_t n = b.size();
   if (p.present && !replace) {
     if (p.theta != s.theta) {
-      fail(path, "holds a perturbation analysis for theta " + std::to_string(p.theta) +
-                     "; use --replace to discard it and start one for theta " + std::to_string(s.theta));
+      fail(path, "holds a perturbation analysis for theta " + exact(p.theta) +
+                     "; use --replace to discard it and start one for theta " + exact(s.theta));
     }
     if (p.seed != s.seed) {
       fail(path, "holds a perturbation analysis with seed " + std::to_string(p.seed) +

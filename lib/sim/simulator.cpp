@@ -202,6 +202,7 @@ RolloutResult simulate(const Simulator& sim, SimulatorWorkspace& ws, const Joint
     }
     if (!within(dq, robot.dq_max)) return finish(RolloutStatus::VelocityLimit, tick + 1);
 
+    result.path_length += (q - q_prev).norm();
     // Collision checks spaced so that no point moves more than the margin between two.
     const double step = sim.lever_arm.dot((q - q_prev).cwiseAbs());
     if (moved + step > margin) {

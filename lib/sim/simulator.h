@@ -67,6 +67,7 @@ struct RolloutResult {
   double duration = 0;        // simulated time, s
   int ticks = 0;              // control ticks simulated
   int collision_checks = 0;
+  double path_length = 0;     // arc length of the motion in joint space, rad
   bool valid() const { return status == RolloutStatus::Valid; }
 };
 

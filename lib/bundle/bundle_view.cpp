@@ -1,0 +1,136 @@
+#include "bundle/bundle_view.h"
+
+#include <fcntl.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+
+#include "bundle/bundle_file.h"
+#include "bundle/hdf5_handle.h"
+#include "common/error.h"
+
+namespace lazyboe {
+
+namespace ds = bundle_dataset;
+
+BundleView::BundleView(BundleView&& o) noexcept { *this = std::move(o); }
+
+BundleView& BundleView::operator=(BundleView&& o) noexcept {
+  if (this == &o) return *this;
+  if (map_) ::munmap(map_, map_bytes_);
+  path_ = std::move(o.path_);
+  header_ = std::move(o.header_);
+  edges_ = o.edges_;
+  map_ = o.map_;
+  map_bytes_ = o.map_bytes_;
+  all_mapped_ = o.all_mapped_;
+  owned_ = std::move(o.owned_);
+  warnings_ = std::move(o.warnings_);
+  q0_ = o.q0_;
+  qf_ = o.qf_;
+  duration_ = o.duration_;
+  command_duration_ = o.command_duration_;
+  knot_offset_ = o.knot_offset_;
+  knots_ = o.knots_;
+  p_lazy_prop_ = o.p_lazy_prop_;
+  p_collision_ = o.p_collision_;
+  perturbation_theta_ = o.perturbation_theta_;
+  has_perturbation_ = o.has_perturbation_;
+  o.map_ = nullptr;
+  return *this;
+}
+
+BundleView::~BundleView() {
+  if (map_) ::munmap(map_, map_bytes_);
+}
+
+CommandProfile BundleView::command(size_t e) const {
+  const int n = dof();
+  return CommandProfile{knots_ + knot_offset_[e] * n,
+                        static_cast<int>(knot_offset_[e + 1] - knot_offset_[e]), n,
+                        command_duration_[e]};
+}
+
+template <typename T>
+const T* BundleView::attach(long file, const std::string& dataset, const std::vector<uint64_t>& dims,
+                            bool allow_mmap) {
+  const std::vector<uint64_t> shape = h5::dataset_shape(path_, file, dataset);
+  if (shape != dims) {
+    fail(path_, dataset + ": shape " + h5::shape_string(shape) + ", expected " + h5::shape_string(dims));
+  }
+  uint64_t count = 1;
+  for (uint64_t d : dims) count *= d;
+  if (count == 0) return nullptr;
+  if (allow_mmap && map_) {
+    const DatasetLocation loc = dataset_location(path_, file, dataset);
+    if (loc.contiguous && loc.bytes == count * sizeof(T) && loc.file_offset % alignof(T) == 0 &&
+        loc.file_offset + loc.bytes <= map_bytes_) {
+      return reinterpret_cast<const T*>(static_cast<const char*>(map_) + loc.file_offset);
+    }
+    warnings_.push_back(dataset + " cannot be memory-mapped (chunked, compressed or unaligned): read into memory");
+  }
+  all_mapped_ = false;
+  auto data = std::make_shared<std::vector<T>>(h5::read_dataset<T>(path_, file, dataset, dims));
+  owned_.push_back(data);
+  return data->data();
+}
+
+BundleView BundleView::open(const std::string& path, bool allow_mmap) {
+  BundleView v;
+  v.path_ = path;
+  uint64_t n = 0;
+  v.header_ = read_bundle_header(path, &n);
+  require_complete(v.header_, path);
+  v.edges_ = n;
+  const uint64_t dof = static_cast<uint64_t>(v.header_.dof);
+
+  if (allow_mmap) {
+    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd < 0) fail(path, std::string("cannot open: ") + std::strerror(errno));
+    struct stat st {};
+    if (::fstat(fd, &st) == 0 && st.st_size > 0) {
+      void* map = ::mmap(nullptr, static_cast<size_t>(st.st_size), PROT_READ, MAP_SHARED, fd, 0);
+      if (map != MAP_FAILED) {
+        v.map_ = map;
+        v.map_bytes_ = static_cast<size_t>(st.st_size);
+      }
+    }
+    ::close(fd);  // the mapping stays valid
+    if (!v.map_) v.warnings_.push_back("cannot memory-map the file: datasets read into memory");
+  }
+  v.all_mapped_ = v.map_ != nullptr;
+
+  h5::File file = h5::open_file(path);
+  v.q0_ = v.attach<double>(file, ds::q0, {n, dof}, allow_mmap);
+  v.qf_ = v.attach<double>(file, ds::qf, {n, dof}, allow_mmap);
+  v.duration_ = v.attach<double>(file, ds::duration, {n}, allow_mmap);
+  v.command_duration_ = v.attach<double>(file, ds::command_duration, {n}, allow_mmap);
+  v.knot_offset_ = v.attach<uint64_t>(file, ds::knot_offset, {n + 1}, allow_mmap);
+  const std::vector<uint64_t> knot_shape = h5::dataset_shape(path, file, ds::knots);
+  if (knot_shape.size() != 2 || knot_shape[1] != dof) fail(path, std::string(ds::knots) + ": expected K x dof");
+  v.knots_ = v.attach<double>(file, ds::knots, knot_shape, allow_mmap);
+  // The offsets index the knots: check them once so that no query can read out of bounds.
+  for (uint64_t e = 0; e < n; ++e) {
+    if (v.knot_offset_[e + 1] < v.knot_offset_[e] + 2 || v.knot_offset_[e + 1] > knot_shape[0]) {
+      fail(path, std::string(ds::knot_offset) + ": edge " + std::to_string(e) + " has a bad knot range");
+    }
+  }
+  if (h5::exists(file, ds::perturbation)) {
+    h5::Group g(H5Gopen2(file, ds::perturbation, H5P_DEFAULT));
+    if (!g.valid()) fail(path, std::string(ds::perturbation) + ": cannot open group");
+    if (h5::read_attr_bool(path, g, "complete")) {
+      v.has_perturbation_ = true;
+      v.perturbation_theta_ = h5::read_attr_f64(path, g, "theta");
+      v.p_lazy_prop_ = v.attach<double>(file, ds::p_lazy_prop, {n}, allow_mmap);
+      v.p_collision_ = v.attach<double>(file, ds::p_collision, {n}, allow_mmap);
+    } else {
+      v.warnings_.push_back("the perturbation analysis is incomplete (finish it with lazyboe-perturb): not used");
+    }
+  }
+  return v;
+}
+
+}  // namespace lazyboe

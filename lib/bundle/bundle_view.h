@@ -1,0 +1,74 @@
+// Read-only access to a bundle for planning: the per-edge datasets the planners use are
+// memory-mapped straight from the HDF5 file (contiguous datasets, at the offsets HDF5 reports),
+// so opening reads almost nothing, processes share one copy in the page cache, and a bundle
+// larger than RAM still works. A dataset that cannot be mapped (chunked, compressed, or not
+// aligned for its type) is read into memory instead, with a warning.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "bundle/bundle.h"
+#include "sim/command_profile.h"
+
+namespace lazyboe {
+
+class BundleView {
+ public:
+  // Throws Error for a missing, corrupt or incomplete bundle. `allow_mmap = false` reads
+  // every dataset into memory (the fallback path, also used to compare both).
+  static BundleView open(const std::string& path, bool allow_mmap = true);
+
+  BundleView(BundleView&&) noexcept;
+  BundleView& operator=(BundleView&&) noexcept;
+  ~BundleView();
+
+  const std::string& path() const { return path_; }
+  const BundleHeader& header() const { return header_; }
+  size_t size() const { return edges_; }
+  int dof() const { return header_.dof; }
+
+  const double* q0(size_t edge) const { return q0_ + edge * dof(); }
+  const double* qf(size_t edge) const { return qf_ + edge * dof(); }
+  double duration(size_t edge) const { return duration_[edge]; }
+  CommandProfile command(size_t edge) const;
+
+  bool has_perturbation() const { return has_perturbation_; }
+  double perturbation_theta() const { return perturbation_theta_; }
+  double p_lazy_prop(size_t edge) const { return p_lazy_prop_[edge]; }
+  double p_collision(size_t edge) const { return p_collision_[edge]; }
+
+  bool memory_mapped() const { return all_mapped_; }  // every dataset mapped
+  const std::vector<std::string>& warnings() const { return warnings_; }
+
+ private:
+  BundleView() = default;
+  template <typename T>
+  const T* attach(long file, const std::string& dataset, const std::vector<uint64_t>& dims,
+                  bool allow_mmap);
+
+  std::string path_;
+  BundleHeader header_;
+  size_t edges_ = 0;
+  // The file mapping (whole file, read-only) and datasets read into memory instead.
+  void* map_ = nullptr;
+  size_t map_bytes_ = 0;
+  bool all_mapped_ = false;
+  std::vector<std::shared_ptr<void>> owned_;
+  std::vector<std::string> warnings_;
+
+  const double* q0_ = nullptr;
+  const double* qf_ = nullptr;
+  const double* duration_ = nullptr;
+  const double* command_duration_ = nullptr;
+  const uint64_t* knot_offset_ = nullptr;
+  const double* knots_ = nullptr;
+  const double* p_lazy_prop_ = nullptr;
+  const double* p_collision_ = nullptr;
+  double perturbation_theta_ = 0;
+  bool has_perturbation_ = false;
+};
+
+}  // namespace lazyboe

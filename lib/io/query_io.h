@@ -1,0 +1,43 @@
+// The query and result formats of lazyboe-query: JSON Lines, one query per line
+// (schemas/query.schema.json) and one result per line (schemas/result.schema.json).
+#pragma once
+
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "bundle/bundle_view.h"
+#include "planning/problem.h"
+
+namespace lazyboe {
+
+struct Query {
+  std::string id;
+  int line = 0;
+  PlanningProblem problem;
+};
+
+// Defaults for fields a query leaves out (from the bundle, when there is one).
+struct QueryDefaults {
+  double theta = 0.35;
+  double budget = 5.0;
+  double joint_tolerance = 0.1;
+  double position_tolerance = 0.02;
+  PlannerParams params;  // sampling box and command family for RRT/SST
+};
+
+// Parses and checks one line (the id first, so even a bad query can be answered by id).
+// Throws Error("line N: field: what") for anything malformed, out of limits or in collision.
+Query parse_query(const std::string& text, int line, const RobotModel& robot, const Simulator& sim,
+                  SimulatorWorkspace& ws, const QueryDefaults& defaults, std::string& id_out);
+
+enum class TrajectoryOutput { None, Inline, Csv };
+
+nlohmann::json result_json(const Query& q, const PlanResult& r, const Trajectory* trajectory,
+                           TrajectoryOutput mode, const std::string& csv_path);
+nlohmann::json error_json(const std::string& id, int line, const std::string& planner,
+                          const std::string& error);
+
+// Writes a trajectory as CSV (t, q1..qn, dq1..dqn).
+void write_trajectory_csv(const std::string& path, const Trajectory& trajectory);
+
+}  // namespace lazyboe

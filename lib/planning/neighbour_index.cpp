@@ -1,0 +1,47 @@
+#include "planning/neighbour_index.h"
+
+#include <nanoflann.hpp>
+
+#include <algorithm>
+
+namespace lazyboe {
+
+namespace {
+
+// nanoflann's view of the edge starts.
+struct StartPoints {
+  const BundleView* bundle;
+  size_t kdtree_get_point_count() const { return bundle->size(); }
+  double kdtree_get_pt(size_t idx, size_t dim) const { return bundle->q0(idx)[dim]; }
+  template <class BBox>
+  bool kdtree_get_bbox(BBox&) const {
+    return false;
+  }
+};
+
+using Tree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, StartPoints>,
+                                                 StartPoints, -1, uint32_t>;
+
+}  // namespace
+
+struct EdgeStartIndex::Impl {
+  StartPoints points;
+  Tree tree;
+  explicit Impl(const BundleView& b)
+      : points{&b}, tree(b.dof(), points, nanoflann::KDTreeSingleIndexAdaptorParams(16)) {
+    tree.buildIndex();
+  }
+};
+
+EdgeStartIndex::EdgeStartIndex(const BundleView& bundle) : impl_(std::make_unique<Impl>(bundle)) {}
+EdgeStartIndex::~EdgeStartIndex() = default;
+
+void EdgeStartIndex::within(const double* q, double radius,
+                            std::vector<std::pair<uint32_t, double>>& out) const {
+  nanoflann::SearchParams params;
+  params.sorted = false;
+  impl_->tree.radiusSearch(q, radius * radius, out, params);  // squared distances for L2_Simple
+  std::sort(out.begin(), out.end());
+}
+
+}  // namespace lazyboe

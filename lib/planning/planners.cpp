@@ -1,0 +1,448 @@
+#include "planning/planners.h"
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <queue>
+#include <unordered_set>
+
+#include "common/error.h"
+#include "sim/random.h"
+
+namespace lazyboe {
+namespace {
+
+struct Node {
+  JointVector q;       // state at rest; for a lazy node, the stored end of its edge
+  int parent = -1;
+  int64_t edge = -1;   // bundle edge from the parent, or index into `commands` (RRT/SST)
+  double cost = 0;     // arc length from the start (estimated for lazy nodes)
+  double h = 0;        // heuristic: distance to the goal
+  bool lazy = false;
+  bool dead = false;   // failed simulation (lazy chains) or pruned (SST)
+  bool expanded = false;
+};
+
+// Bookkeeping common to every search: nodes, solutions, counters.
+class SearchState {
+ public:
+  SearchState(const PlanningContext& ctx, SimulatorWorkspace& ws, const PlanningProblem& p)
+      : ctx_(ctx), ws_(ws), problem_(p), deadline_(p.params.budget), goal_data_(ctx.sim.robot) {}
+
+  const PlanningProblem& problem() const { return problem_; }
+  const Deadline& deadline() const { return deadline_; }
+  std::vector<Node>& nodes() { return nodes_; }
+  PlanResult& result() { return result_; }
+
+  double heuristic(const JointVectorRef& q) { return problem_.goal.distance(ctx_.sim.robot, goal_data_, q); }
+  bool in_goal(double h) const { return h <= problem_.goal.tolerance; }
+
+  int add(Node n) {
+    nodes_.push_back(std::move(n));
+    ++result_.counters.nodes;
+    return static_cast<int>(nodes_.size()) - 1;
+  }
+
+  RolloutResult simulate_from(const JointVectorRef& q, const CommandProfile& profile) {
+    ++result_.counters.simulations;
+    const RolloutResult r = simulate(ctx_.sim, ws_, q, profile);
+    result_.counters.collision_checks += r.collision_checks;
+    return r;
+  }
+
+  // A real node inside the goal region: a solution.
+  void solution(int node, const std::function<std::vector<PathStep>(int)>& path_to) {
+    ++result_.n_solutions;
+    if (!result_.success) {
+      result_.success = true;
+      result_.time_to_first_solution = deadline_.elapsed();
+    }
+    if (!(nodes_[node].cost >= result_.best_cost)) {  // also when best_cost is NaN
+      result_.best_cost = nodes_[node].cost;
+      result_.best_path = path_to(node);
+    }
+  }
+
+  bool should_stop() const {
+    return deadline_.passed() || (problem_.params.stop_at_first && result_.success);
+  }
+
+ private:
+  const PlanningContext& ctx_;
+  SimulatorWorkspace& ws_;
+  const PlanningProblem& problem_;
+  Deadline deadline_;
+  RobotData goal_data_;
+  std::vector<Node> nodes_;
+  PlanResult result_;
+};
+
+JointVector row(const double* p, int n) { return Eigen::Map<const Eigen::VectorXd>(p, n); }
+
+// ---- BoE and LazyBoE ------------------------------------------------------------------------
+
+class BundleSearch {
+ public:
+  BundleSearch(const PlanningContext& ctx, SimulatorWorkspace& ws, const PlanningProblem& p, bool lazy)
+      : ctx_(ctx), s_(ctx, ws, p), lazy_(lazy), theta_(p.params.theta), rng_(p.params.seed, 0) {}
+
+  PlanResult run() {
+    const BundleView& b = *ctx_.bundle;
+    const int n = b.dof();
+    Node root;
+    root.q = s_.problem().start;
+    root.h = s_.heuristic(root.q);
+    push(s_.add(root));
+    std::vector<std::pair<uint32_t, double>> neighbours;
+    // Coverage: a start or goal the bundle cannot reach is a clear failure, not a timeout.
+    ctx_.index->within(root.q.data(), theta_, neighbours);
+    if (neighbours.empty()) {
+      s_.result().failure = "no bundle edge starts within theta = " + std::to_string(theta_) +
+                            " rad of the start: it is outside the bundle's coverage";
+      return s_.result();
+    }
+    const Goal& goal = s_.problem().goal;
+    if (goal.kind == Goal::Kind::Joint) {
+      const double reach = theta_ + goal.tolerance;
+      bool covered = false;
+      for (size_t e = 0; e < b.size() && !covered; ++e) {
+        covered = (row(b.qf(e), n) - goal.q).squaredNorm() <= reach * reach;
+      }
+      if (!covered) {
+        s_.result().failure = "no bundle edge ends within theta + tolerance = " + std::to_string(reach) +
+                              " rad of the goal: it is outside the bundle's coverage";
+        return s_.result();
+      }
+    }
+    while (!s_.should_stop()) {
+      if (open_.empty()) {
+        // LazyBoE: once the lazy search has run dry, every edge it took lazily is simulated
+        // from its node (a second, exhaustive pass over the real nodes, as BoE would).
+        if (!lazy_ || exhaustive_) break;
+        exhaustive_ = true;
+        for (size_t u = 0; u < s_.nodes().size(); ++u) {
+          Node& node = s_.nodes()[u];
+          if (node.lazy || node.dead || s_.in_goal(node.h)) continue;
+          node.expanded = false;
+          push(static_cast<int>(u));
+        }
+        if (open_.empty()) break;
+      }
+      const int v = open_.top().second;
+      open_.pop();
+      if (s_.nodes()[v].expanded || dead(v)) continue;
+      if (s_.in_goal(s_.nodes()[v].h) && !s_.nodes()[v].lazy) continue;  // already a solution
+      if (prunable(v)) continue;
+      s_.nodes()[v].expanded = true;
+      const double radius = s_.nodes()[v].lazy ? theta_ / 2 : theta_;
+      ctx_.index->within(s_.nodes()[v].q.data(), radius, neighbours);
+      if (neighbours.empty() && s_.nodes()[v].lazy) {
+        // The lazy chain cannot go on (nothing starts within theta/2 of its stored end): it
+        // terminates, is simulated, and the node is expanded as a real one.
+        if (!realize(v)) continue;
+        ctx_.index->within(s_.nodes()[v].q.data(), theta_, neighbours);
+      }
+      for (const auto& [e, d2] : neighbours) {
+        (void)d2;
+        if (s_.should_stop() || dead(v)) break;
+        if (lazy_ && !exhaustive_) {
+          const double p_select = (1 - b.p_collision(e)) * b.p_lazy_prop(e);
+          if (rng_.uniform() < p_select) {
+            take_lazily(v, e, n);
+            continue;
+          }
+          if (s_.nodes()[v].lazy && !realize(v)) break;  // simulate the lazy chain up to v first
+        }
+        simulate_edge(v, e);
+      }
+    }
+    PlanResult& r = s_.result();
+    if (!r.success && r.failure.empty()) {
+      r.failure = open_.empty() ? "search exhausted: no more nodes to expand within the bundle"
+                                : "no solution within the time budget";
+    }
+    return r;
+  }
+
+ private:
+  void push(int node) { open_.emplace(s_.nodes()[node].h, node); }
+
+  // A node under a dead ancestor (a lazy chain that failed) is dead too.
+  bool dead(int v) {
+    for (int u = v; u >= 0; u = s_.nodes()[u].parent) {
+      if (s_.nodes()[u].dead) return true;
+      if (!s_.nodes()[u].lazy) break;
+    }
+    return false;
+  }
+
+  // After a solution, a node whose cost plus the least remaining arc length (joint goals:
+  // distance to the goal minus the tolerance) cannot beat the best is not expanded.
+  bool prunable(int v) {
+    const PlanResult& r = s_.result();
+    if (!r.success || s_.problem().goal.kind != Goal::Kind::Joint) return false;
+    const Node& node = s_.nodes()[v];
+    return node.cost + std::max(0.0, node.h - s_.problem().goal.tolerance) >= r.best_cost;
+  }
+
+  std::vector<PathStep> path_to(int node) {
+    std::vector<PathStep> steps;
+    const BundleView& b = *ctx_.bundle;
+    for (int u = node; s_.nodes()[u].parent >= 0; u = s_.nodes()[u].parent) {
+      const CommandProfile c = b.command(s_.nodes()[u].edge);
+      steps.push_back({s_.nodes()[u].edge, std::vector<double>(c.knots, c.knots + c.n_knots * c.dof), c.duration});
+    }
+    std::reverse(steps.begin(), steps.end());
+    return steps;
+  }
+
+  void found(int node) { s_.solution(node, [this](int u) { return path_to(u); }); }
+
+  void simulate_edge(int v, uint32_t e) {
+    // The same edge from the same real node always gives the same rollout: never twice.
+    if (!simulated_.insert((static_cast<uint64_t>(v) << 32) | e).second) return;
+    const RolloutResult r = s_.simulate_from(s_.nodes()[v].q, ctx_.bundle->command(e));
+    if (!r.valid()) return;
+    Node c;
+    c.q = r.qf;
+    c.parent = v;
+    c.edge = e;
+    c.cost = s_.nodes()[v].cost + r.path_length;
+    c.h = s_.heuristic(c.q);
+    const int id = s_.add(c);
+    if (s_.in_goal(c.h)) {
+      found(id);
+    } else {
+      push(id);
+    }
+  }
+
+  void take_lazily(int v, uint32_t e, int n) {
+    const BundleView& b = *ctx_.bundle;
+    ++s_.result().counters.lazy_edges;
+    Node c;
+    c.q = row(b.qf(e), n);
+    c.parent = v;
+    c.edge = e;
+    c.lazy = true;
+    c.cost = s_.nodes()[v].cost + (row(b.qf(e), n) - row(b.q0(e), n)).norm();
+    c.h = s_.heuristic(c.q);
+    const int id = s_.add(c);
+    // SHOULD_TERMINATE_LAZY: the lazy path reaches the goal region (simulate it, the child
+    // included), or the heuristic rises again (simulate the chain up to the parent, which was
+    // the best point of it; the child waits in the queue).
+    if (s_.in_goal(c.h)) {
+      realize(id);
+    } else if (c.h > s_.nodes()[v].h && s_.nodes()[v].lazy) {
+      if (realize(v)) push(id);
+    } else {
+      push(id);
+    }
+  }
+
+  // Simulates the lazy chain ending at `x` from its last simulated ancestor. Nodes that pass
+  // become real (their state the simulated end); the first failure kills the rest of the chain.
+  bool realize(int x) {
+    std::vector<int> chain;
+    for (int u = x; s_.nodes()[u].lazy; u = s_.nodes()[u].parent) chain.push_back(u);
+    std::reverse(chain.begin(), chain.end());
+    for (int u : chain) {
+      Node& node = s_.nodes()[u];
+      const Node& parent = s_.nodes()[node.parent];
+      const RolloutResult r = s_.simulate_from(parent.q, ctx_.bundle->command(node.edge));
+      if (!r.valid()) {
+        s_.nodes()[u].dead = true;
+        return false;
+      }
+      Node& n = s_.nodes()[u];  // (no reallocation above, but keep references short)
+      n.q = r.qf;
+      n.lazy = false;
+      n.cost = s_.nodes()[n.parent].cost + r.path_length;
+      n.h = s_.heuristic(n.q);
+      if (s_.in_goal(n.h)) {
+        found(u);
+      } else if (!n.expanded) {
+        push(u);  // re-queued with its real heuristic
+      }
+    }
+    return true;
+  }
+
+  const PlanningContext& ctx_;
+  SearchState s_;
+  bool lazy_;
+  bool exhaustive_ = false;
+  std::unordered_set<uint64_t> simulated_;  // (node, edge) pairs simulated
+  double theta_;
+  Random rng_;
+  std::priority_queue<std::pair<double, int>, std::vector<std::pair<double, int>>, std::greater<>> open_;
+};
+
+// ---- RRT and SST ----------------------------------------------------------------------------
+
+class TreeSearch {
+ public:
+  TreeSearch(const PlanningContext& ctx, SimulatorWorkspace& ws, const PlanningProblem& p, bool sst)
+      : ctx_(ctx), s_(ctx, ws, p), sst_(sst), rng_(p.params.seed, 1) {}
+
+  PlanResult run() {
+    const PlannerParams& params = s_.problem().params;
+    const int n = ctx_.sim.robot.dof;
+    Node root;
+    root.q = s_.problem().start;
+    root.h = s_.heuristic(root.q);
+    s_.add(root);
+    children_.push_back(0);
+    if (sst_) witnesses_.push_back({root.q, 0});
+    const double delta_bn = params.selection_radius, delta_s = params.pruning_ratio * params.selection_radius;
+    JointVector x(n);
+    std::vector<double> knots;
+    while (!s_.should_stop()) {
+      sample(x);
+      const int from = sst_ ? select_sst(x, delta_bn) : nearest(x);
+      const double duration = sample_command_profile(ctx_.sim.robot, params.command, rng_, knots);
+      const CommandProfile profile{knots.data(), static_cast<int>(knots.size() / n), n, duration};
+      const RolloutResult r = s_.simulate_from(s_.nodes()[from].q, profile);
+      if (!r.valid()) continue;
+      Node c;
+      c.q = r.qf;
+      c.parent = from;
+      c.cost = s_.nodes()[from].cost + r.path_length;
+      c.h = s_.heuristic(c.q);
+      int witness = -1;
+      if (sst_) {
+        witness = nearest_witness(c.q);
+        if (witness < 0 || (witnesses_[witness].q - c.q).norm() > delta_s) {
+          witnesses_.push_back({c.q, -1});
+          witness = static_cast<int>(witnesses_.size()) - 1;
+        }
+        const int rep = witnesses_[witness].representative;
+        if (rep >= 0 && s_.nodes()[rep].cost <= c.cost) continue;  // not better locally: drop
+        if (rep >= 0) deactivate(rep);
+      }
+      c.edge = static_cast<int64_t>(commands_.size());
+      commands_.push_back({-1, knots, duration});
+      const int id = s_.add(c);
+      children_.push_back(0);
+      ++children_[from];
+      if (sst_) witnesses_[witness].representative = id;
+      if (s_.in_goal(c.h)) {
+        s_.solution(id, [this](int u) { return path_to(u); });
+        if (!sst_) break;  // RRT stops at its first solution
+      }
+    }
+    PlanResult& r = s_.result();
+    if (!r.success) r.failure = "no solution within the time budget";
+    return r;
+  }
+
+ private:
+  struct Witness {
+    JointVector q;
+    int representative;
+  };
+
+  void sample(JointVector& x) {
+    const PlannerParams& p = s_.problem().params;
+    if (s_.problem().goal.kind == Goal::Kind::Joint && rng_.uniform() < p.goal_bias) {
+      x = s_.problem().goal.q;
+      return;
+    }
+    for (int i = 0; i < x.size(); ++i) x[i] = rng_.uniform(p.sample_lower[i], p.sample_upper[i]);
+  }
+
+  bool active(int v) const { return !s_nodes_const()[v].dead && !s_nodes_const()[v].lazy; }
+  const std::vector<Node>& s_nodes_const() const { return const_cast<SearchState&>(s_).nodes(); }
+
+  int nearest(const JointVector& x) {
+    int best = 0;
+    double best_d = std::numeric_limits<double>::infinity();
+    const std::vector<Node>& nodes = s_.nodes();
+    for (size_t v = 0; v < nodes.size(); ++v) {
+      if (nodes[v].dead || nodes[v].lazy) continue;  // SST: `lazy` marks inactive nodes
+      const double d = (nodes[v].q - x).squaredNorm();
+      if (d < best_d) {
+        best_d = d;
+        best = static_cast<int>(v);
+      }
+    }
+    return best;
+  }
+
+  // SST's Best-Near selection: the lowest-cost active node within delta_BN, else the nearest.
+  int select_sst(const JointVector& x, double delta_bn) {
+    int best = -1;
+    double best_cost = std::numeric_limits<double>::infinity();
+    const std::vector<Node>& nodes = s_.nodes();
+    for (size_t v = 0; v < nodes.size(); ++v) {
+      if (nodes[v].dead || nodes[v].lazy) continue;
+      if ((nodes[v].q - x).norm() <= delta_bn && nodes[v].cost < best_cost) {
+        best_cost = nodes[v].cost;
+        best = static_cast<int>(v);
+      }
+    }
+    return best >= 0 ? best : nearest(x);
+  }
+
+  int nearest_witness(const JointVector& q) const {
+    int best = -1;
+    double best_d = std::numeric_limits<double>::infinity();
+    for (size_t w = 0; w < witnesses_.size(); ++w) {
+      const double d = (witnesses_[w].q - q).squaredNorm();
+      if (d < best_d) {
+        best_d = d;
+        best = static_cast<int>(w);
+      }
+    }
+    return best;
+  }
+
+  // The old representative becomes inactive; inactive leaves are removed, recursively upwards.
+  void deactivate(int v) {
+    std::vector<Node>& nodes = s_.nodes();
+    nodes[v].lazy = true;  // inactive
+    while (v > 0 && nodes[v].lazy && !nodes[v].dead && children_[v] == 0) {
+      nodes[v].dead = true;
+      const int parent = nodes[v].parent;
+      --children_[parent];
+      v = parent;
+    }
+  }
+
+  std::vector<PathStep> path_to(int node) {
+    std::vector<PathStep> steps;
+    for (int u = node; s_.nodes()[u].parent >= 0; u = s_.nodes()[u].parent) steps.push_back(commands_[s_.nodes()[u].edge]);
+    std::reverse(steps.begin(), steps.end());
+    return steps;
+  }
+
+  const PlanningContext& ctx_;
+  SearchState s_;
+  bool sst_;
+  Random rng_;
+  std::vector<PathStep> commands_;
+  std::vector<int> children_;
+  std::vector<Witness> witnesses_;
+};
+
+}  // namespace
+
+PlanResult plan(const PlanningContext& ctx, SimulatorWorkspace& ws, const PlanningProblem& problem) {
+  const std::string& name = problem.params.planner;
+  if (name == "boe" || name == "lazyboe") {
+    if (!ctx.bundle || !ctx.index) fail("planner", name + " needs an edge bundle");
+    if (name == "lazyboe" && !ctx.bundle->has_perturbation()) {
+      fail(ctx.bundle->path(), "has no complete perturbation analysis, which lazyboe needs (run lazyboe-perturb)");
+    }
+    if (!(problem.params.theta > 0)) fail("theta", "must be > 0");
+    return BundleSearch(ctx, ws, problem, name == "lazyboe").run();
+  }
+  if (name == "rrt" || name == "sst") {
+    PlanningProblem p = problem;
+    if (name == "rrt") p.params.stop_at_first = true;
+    return TreeSearch(ctx, ws, p, name == "sst").run();
+  }
+  fail("planner", "unknown planner '" + name + "' (expected lazyboe, boe, rrt or sst)");
+}
+
+}  // namespace lazyboe

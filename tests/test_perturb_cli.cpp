@@ -1,0 +1,986 @@
+// End-to-end tests of the lazyboe-perturb command-line tool: real bundles made by lazyboe-build
+// are analysed by the real binary and read back with the library (and, for the layout of the
+// /perturbation group, with the HDF5 C API directly).
+// Covered: the per-edge numbers and their invariants, the group attributes and the summary;
+// the same numbers whatever the thread count; extending p, re-running a complete analysis, the
+// refusals of fewer perturbations / another theta / another seed and --replace; SIGINT and
+// SIGKILL in the middle of a run and resuming to the uninterrupted result; one-line errors for
+// bad input that leave the bundle untouched; robot and environment checked by content; the
+// physics in broad strokes.
+//
+// Run time matters (the whole file should stay well under a minute on two cores; about 900
+// rollouts/s with two threads; about 17000 rollouts in all): input bundles of 100-300 edges are
+// built once per test binary and copied, and each uninterrupted reference analysis is run once
+// and cached.
+#include <fcntl.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <gtest/gtest.h>
+#include <hdf5.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <functional>
+#include <map>
+#include <numeric>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <utility>
+#include <vector>
+
+#include "bundle/bundle.h"
+#include "bundle/bundle_file.h"
+#include "test_util.h"
+
+extern char** environ;
+
+namespace lazyboe::test {
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+// ------------------------------------------------------------------------------------------
+// Running the tools
+// ------------------------------------------------------------------------------------------
+
+std::string quote(const std::string& s) {
+  std::string out = "'";
+  for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return out + "'";
+}
+
+// The shell command line of a tool with the given arguments (each shell-quoted), under a
+// watchdog that kills a run that does not end (a hang fails the test instead of stalling it).
+std::string tool_command(const std::string& tool, const std::vector<std::string>& args, double timeout_seconds) {
+  std::string cmd = "timeout -s KILL " + std::to_string(timeout_seconds) + " " + quote(tool_path(tool));
+  for (const std::string& a : args) cmd += " " + quote(a);
+  return cmd;
+}
+
+CommandResult perturb_tool(const std::vector<std::string>& args, double timeout_seconds = 120) {
+  return run(tool_command("lazyboe-perturb", args, timeout_seconds));
+}
+
+// The same, run inside `dir` (anything written by mistake to a relative path lands there).
+CommandResult perturb_tool_in(const std::string& dir, const std::vector<std::string>& args,
+                              double timeout_seconds = 20) {
+  return run("cd " + quote(dir) + " && " + tool_command("lazyboe-perturb", args, timeout_seconds));
+}
+
+CommandResult build_tool(const std::vector<std::string>& args, double timeout_seconds = 120) {
+  return run(tool_command("lazyboe-build", args, timeout_seconds));
+}
+
+std::string describe(const CommandResult& r) {
+  return "exit " + std::to_string(r.exit_code) + "\n--- stdout:\n" + r.out + "--- stderr:\n" + r.err;
+}
+
+long count_lines(const std::string& s) { return std::count(s.begin(), s.end(), '\n'); }
+
+bool contains(const std::string& haystack, const std::string& needle) {
+  return haystack.find(needle) != std::string::npos;
+}
+
+std::string join(const std::vector<std::string>& v) {
+  std::string s;
+  for (const std::string& x : v) s += (s.empty() ? "" : ", ") + x;
+  return s;
+}
+
+// A failure as the tools promise it: a normal non-zero exit (no signal, no abort, no watchdog
+// kill), nothing on stdout, and exactly one line on stderr that contains every one of `needles`.
+void expect_one_line_error(const CommandResult& r, const std::vector<std::string>& needles) {
+  std::string problems;
+  if (r.exit_code == 0) problems += "  exit status 0 (expected failure)\n";
+  if (r.exit_code < 0 || r.exit_code >= 124) problems += "  exit status looks like a signal, crash or timeout\n";
+  if (count_lines(r.err) != 1 || r.err.empty() || r.err.back() != '\n') {
+    problems += "  expected exactly one line on stderr, got " + std::to_string(count_lines(r.err)) + "\n";
+  }
+  if (!r.out.empty()) problems += "  stdout is not empty\n";
+  for (const std::string& n : needles) {
+    if (!contains(r.err, n)) problems += "  stderr does not mention '" + n + "'\n";
+  }
+  EXPECT_TRUE(problems.empty()) << problems << describe(r);
+}
+
+// A fresh, empty directory under the test's temp dir.
+std::string fresh_dir(const std::string& name) {
+  const std::string dir = temp_dir() + "/" + name;
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+std::vector<std::string> files_in(const std::string& dir) {
+  std::vector<std::string> out;
+  for (const auto& e : fs::directory_iterator(dir)) out.push_back(e.path().filename().string());
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+// Temporary files of the crash-safe writer ("<path>.tmp.<pid>").
+std::vector<std::string> tmp_files_in(const std::string& dir) {
+  std::vector<std::string> out;
+  for (const std::string& f : files_in(dir)) {
+    if (contains(f, ".tmp.")) out.push_back(f);
+  }
+  return out;
+}
+
+// Every file of a directory with its bytes.
+std::map<std::string, std::string> snapshot(const std::string& dir) {
+  std::map<std::string, std::string> out;
+  for (const std::string& f : files_in(dir)) out[f] = read_file(dir + "/" + f);
+  return out;
+}
+
+void write_bytes(const std::string& path, const std::string& bytes) {
+  std::FILE* f = std::fopen(path.c_str(), "wb");
+  ASSERT_NE(f, nullptr) << path;
+  std::fwrite(bytes.data(), 1, bytes.size(), f);
+  std::fclose(f);
+}
+
+std::string garbage_bytes() {
+  std::string s;
+  uint32_t x = 12345;
+  for (int i = 0; i < 4096; ++i) {
+    x = x * 1664525u + 1013904223u;
+    s += static_cast<char>(x >> 24);
+  }
+  return s;
+}
+
+std::string env_file(const std::string& name) { return source_path("data/environments/" + name); }
+
+// ---- A run in the background, for signals -------------------------------------------------
+
+struct Background {
+  pid_t pid = -1;
+  std::string out_path, err_path;
+  Clock::time_point started;
+};
+
+Background spawn_perturb(const std::vector<std::string>& args, const std::string& log_prefix) {
+  Background b;
+  b.out_path = log_prefix + ".stdout";
+  b.err_path = log_prefix + ".stderr";
+  const std::string tool = tool_path("lazyboe-perturb");
+  std::vector<std::string> all = {tool};
+  all.insert(all.end(), args.begin(), args.end());
+  std::vector<char*> argv;
+  for (std::string& a : all) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
+  posix_spawn_file_actions_addopen(&actions, 1, b.out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_addopen(&actions, 2, b.err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  b.started = Clock::now();
+  const int rc = posix_spawn(&b.pid, tool.c_str(), &actions, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  if (rc != 0) {
+    ADD_FAILURE() << "posix_spawn " << tool << ": " << std::strerror(rc);
+    b.pid = -1;
+  }
+  return b;
+}
+
+// Waits for the process; the exit status, or -signal when it was killed by a signal.
+int wait_for(Background& b) {
+  if (b.pid < 0) return -1000;
+  int status = 0;
+  while (::waitpid(b.pid, &status, 0) < 0 && errno == EINTR) {
+  }
+  b.pid = -1;
+  if (WIFEXITED(status)) return WEXITSTATUS(status);
+  if (WIFSIGNALED(status)) return -WTERMSIG(status);
+  return -1000;
+}
+
+void sleep_seconds(double s) { std::this_thread::sleep_for(std::chrono::duration<double>(s)); }
+
+// The file's identity: a checkpoint renames a new file over it, which changes the inode.
+ino_t inode_of(const std::string& path) {
+  struct stat st {};
+  return ::stat(path.c_str(), &st) == 0 ? st.st_ino : 0;
+}
+
+// Waits until the bundle at `path` has been replaced by a checkpoint (its inode changes) while
+// the process still runs. False when the process ended first (it is then reaped: b.pid = -1,
+// `exit_code` set) or after the timeout.
+bool wait_for_checkpoint(Background& b, const std::string& path, ino_t before, double timeout_seconds,
+                         int& exit_code) {
+  const auto until = Clock::now() + std::chrono::duration<double>(timeout_seconds);
+  while (Clock::now() < until) {
+    int status = 0;
+    if (::waitpid(b.pid, &status, WNOHANG) == b.pid) {
+      b.pid = -1;
+      exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -WTERMSIG(status);
+      return false;
+    }
+    const ino_t now = inode_of(path);
+    if (now != 0 && now != before) return true;
+    sleep_seconds(0.01);
+  }
+  return false;
+}
+
+void sleep_until(Clock::time_point t) { std::this_thread::sleep_until(t); }
+
+// ------------------------------------------------------------------------------------------
+// Comparing bundles
+// ------------------------------------------------------------------------------------------
+
+// Bit-for-bit equality of two arrays, reporting the first difference.
+template <typename T>
+::testing::AssertionResult same_array(const std::string& name, const std::vector<T>& a, const std::vector<T>& b) {
+  if (a.size() != b.size()) {
+    return ::testing::AssertionFailure() << name << ": " << a.size() << " vs " << b.size() << " values";
+  }
+  for (size_t i = 0; i < a.size(); ++i) {
+    if (std::memcmp(&a[i], &b[i], sizeof(T)) != 0) {
+      std::ostringstream o;
+      o.precision(17);
+      o << name << ": first difference at element " << i << " of " << a.size() << ": " << a[i] << " vs " << b[i];
+      return ::testing::AssertionFailure() << o.str();
+    }
+  }
+  return ::testing::AssertionSuccess();
+}
+
+bool same_double(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+// Every edge dataset of the two bundles is identical, and so is the header (all but
+// wall_seconds and tool_version).
+void expect_same_edges(const Bundle& a, const Bundle& b) {
+  EXPECT_EQ(a.size(), b.size());
+  EXPECT_TRUE(same_array("q0", a.q0, b.q0));
+  EXPECT_TRUE(same_array("qf", a.qf, b.qf));
+  EXPECT_TRUE(same_array("duration", a.duration, b.duration));
+  EXPECT_TRUE(same_array("command_duration", a.command_duration, b.command_duration));
+  EXPECT_TRUE(same_array("attempt", a.attempt, b.attempt));
+  EXPECT_TRUE(same_array("knot_offset", a.knot_offset, b.knot_offset));
+  EXPECT_TRUE(same_array("knots", a.knots, b.knots));
+  EXPECT_TRUE(same_array("sample_offset", a.sample_offset, b.sample_offset));
+  EXPECT_TRUE(same_array("sample_q", a.sample_q, b.sample_q));
+  EXPECT_TRUE(same_array("sample_dq", a.sample_dq, b.sample_dq));
+  const BundleHeader &x = a.header, &y = b.header;
+  EXPECT_EQ(x.complete, y.complete);
+  EXPECT_EQ(x.robot_config, y.robot_config);
+  EXPECT_EQ(x.robot_hash, y.robot_hash);
+  EXPECT_EQ(x.env_file, y.env_file);
+  EXPECT_EQ(x.env_hash, y.env_hash);
+  EXPECT_EQ(x.seed, y.seed);
+  EXPECT_EQ(x.target_edges, y.target_edges);
+  EXPECT_EQ(x.attempts, y.attempts);
+  EXPECT_EQ(x.valid, y.valid);
+  EXPECT_EQ(x.rejected, y.rejected);
+  EXPECT_TRUE(same_double(x.design_theta, y.design_theta));
+  EXPECT_TRUE(same_double(x.simulated_seconds, y.simulated_seconds));
+  EXPECT_TRUE(same_double(x.wall_seconds, y.wall_seconds)) << "the build's wall_seconds was changed";
+}
+
+// The two analyses hold the same numbers: settings and every per-edge dataset bit for bit.
+// simulated_seconds is a sum whose order depends on how the work was split: close, not equal.
+// With `work` also the bookkeeping attributes must be identical (an untouched analysis).
+void expect_same_perturbation(const Perturbation& a, const Perturbation& b, bool work = false) {
+  EXPECT_EQ(a.present, b.present);
+  EXPECT_EQ(a.complete, b.complete);
+  EXPECT_TRUE(same_double(a.theta, b.theta)) << a.theta << " vs " << b.theta;
+  EXPECT_EQ(a.perturbations, b.perturbations);
+  EXPECT_EQ(a.seed, b.seed);
+  EXPECT_TRUE(same_array("perturbation/done", a.done, b.done));
+  EXPECT_TRUE(same_array("perturbation/valid", a.valid, b.valid));
+  EXPECT_TRUE(same_array("perturbation/lazy", a.lazy, b.lazy));
+  EXPECT_TRUE(same_array("perturbation/collision", a.collision, b.collision));
+  EXPECT_TRUE(same_array("perturbation/max_error", a.max_error, b.max_error));
+  EXPECT_TRUE(same_array("perturbation/p_lazy_prop", a.p_lazy_prop, b.p_lazy_prop));
+  EXPECT_TRUE(same_array("perturbation/p_collision", a.p_collision, b.p_collision));
+  EXPECT_NEAR(a.simulated_seconds, b.simulated_seconds, 1e-9 * std::max(1.0, std::abs(b.simulated_seconds)));
+  if (work) {
+    EXPECT_TRUE(same_double(a.simulated_seconds, b.simulated_seconds));
+    EXPECT_TRUE(same_double(a.wall_seconds, b.wall_seconds)) << a.wall_seconds << " vs " << b.wall_seconds;
+  }
+}
+
+// The per-edge invariants of an analysis, finished or not. Returns the number of edges done.
+size_t check_invariants(const Bundle& b) {
+  const Perturbation& p = b.perturbation;
+  const size_t N = b.size();
+  EXPECT_TRUE(p.present);
+  EXPECT_EQ(p.done.size(), N);
+  EXPECT_EQ(p.valid.size(), N);
+  EXPECT_EQ(p.lazy.size(), N);
+  EXPECT_EQ(p.collision.size(), N);
+  EXPECT_EQ(p.max_error.size(), N);
+  EXPECT_EQ(p.p_lazy_prop.size(), N);
+  EXPECT_EQ(p.p_collision.size(), N);
+  if (p.done.size() != N || p.valid.size() != N || p.lazy.size() != N || p.collision.size() != N ||
+      p.max_error.size() != N || p.p_lazy_prop.size() != N || p.p_collision.size() != N) {
+    return 0;
+  }
+  size_t finished = 0;
+  int reported = 0;  // stop after a few failing edges
+  for (size_t e = 0; e < N && reported < 5; ++e) {
+    std::ostringstream where;
+    where.precision(17);
+    where << "edge " << e << ": done " << p.done[e] << ", valid " << p.valid[e] << ", lazy " << p.lazy[e]
+          << ", collision " << p.collision[e] << ", max_error " << p.max_error[e] << ", p_lazy_prop "
+          << p.p_lazy_prop[e] << ", p_collision " << p.p_collision[e];
+    std::string problems;
+    // An edge is processed whole: 0 or p done.
+    if (p.done[e] != 0 && p.done[e] != p.perturbations) problems += " done is neither 0 nor p;";
+    finished += p.done[e] == p.perturbations;
+    if (p.valid[e] + p.collision[e] > p.done[e]) problems += " valid + collision > done;";
+    if (p.lazy[e] > p.valid[e]) problems += " lazy > valid;";
+    if (!(p.p_lazy_prop[e] >= 0 && p.p_lazy_prop[e] <= 1)) problems += " p_lazy_prop outside [0, 1];";
+    if (!(p.p_collision[e] >= 0 && p.p_collision[e] <= 1)) problems += " p_collision outside [0, 1];";
+    const double lazy_prop = p.valid[e] ? static_cast<double>(p.lazy[e]) / p.valid[e] : 0.0;
+    if (!same_double(p.p_lazy_prop[e], lazy_prop)) problems += " p_lazy_prop != lazy / valid;";
+    const double collision = p.done[e] ? static_cast<double>(p.collision[e]) / p.done[e] : 0.0;
+    if (!same_double(p.p_collision[e], collision)) problems += " p_collision != collision / done;";
+    if (p.valid[e] == 0) {
+      if (!std::isnan(p.max_error[e])) problems += " max_error is not NaN with no valid rollout;";
+    } else if (!(p.max_error[e] >= 0)) {
+      problems += " max_error is not >= 0 (or is NaN) with valid rollouts;";
+    }
+    if (!problems.empty()) {
+      ADD_FAILURE() << where.str() << ":" << problems;
+      ++reported;
+    }
+  }
+  return finished;
+}
+
+// ------------------------------------------------------------------------------------------
+// Inputs and references, made once per test binary
+// ------------------------------------------------------------------------------------------
+
+// A complete bundle of `edges` edges on `env`, built once; never modified (tests copy it).
+const std::string& input_bundle(uint64_t edges, uint64_t seed, const std::string& env = "table.json") {
+  static std::map<std::string, std::string> cache;
+  const std::string key = std::to_string(edges) + "-" + std::to_string(seed) + "-" + env;
+  const auto it = cache.find(key);
+  if (it != cache.end()) return it->second;
+  const std::string dir = fresh_dir("input-" + key);
+  const std::string out = dir + "/input.h5";
+  const CommandResult r = build_tool({"--out", out, "--edges", std::to_string(edges), "--seed", std::to_string(seed),
+                                      "--env", env_file(env), "--threads", "2", "--quiet"});
+  EXPECT_EQ(r.exit_code, 0) << "input build: " << describe(r);
+  return cache[key] = out;
+}
+
+// A copy of an input bundle at `path` (writable).
+void copy_bundle(const std::string& from, const std::string& path) {
+  fs::copy_file(from, path, fs::copy_options::overwrite_existing);
+}
+
+// An uninterrupted analysis of a copy of `input` with `args` (2 threads, quiet), run once.
+const Bundle& reference(const std::string& input, const std::vector<std::string>& args) {
+  static std::map<std::string, Bundle> cache;
+  static int counter = 0;
+  const std::string key = input + " " + join(args);
+  const auto it = cache.find(key);
+  if (it != cache.end()) return it->second;
+  const std::string dir = fresh_dir("reference-" + std::to_string(counter++));
+  const std::string path = dir + "/reference.h5";
+  copy_bundle(input, path);
+  std::vector<std::string> all = {"--bundle", path, "--threads", "2", "--quiet"};
+  all.insert(all.end(), args.begin(), args.end());
+  const CommandResult r = perturb_tool(all);
+  EXPECT_EQ(r.exit_code, 0) << "reference run " << key << ": " << describe(r);
+  return cache[key] = read_bundle(path);
+}
+
+// ------------------------------------------------------------------------------------------
+// 1. A basic run
+// ------------------------------------------------------------------------------------------
+
+constexpr uint64_t kBasicEdges = 300, kBasicSeed = 21, kBasicP = 8;
+
+struct Hdf5Check {
+  bool exists = false;
+  bool type_ok = false;
+  std::vector<hsize_t> dims;
+};
+
+Hdf5Check dataset_check(hid_t file, const char* name, hid_t expected_type) {
+  Hdf5Check c;
+  if (H5Lexists(file, name, H5P_DEFAULT) <= 0) return c;
+  const hid_t ds = H5Dopen2(file, name, H5P_DEFAULT);
+  if (ds < 0) return c;
+  c.exists = true;
+  const hid_t space = H5Dget_space(ds);
+  const int rank = H5Sget_simple_extent_ndims(space);
+  c.dims.resize(std::max(rank, 0));
+  if (rank > 0) H5Sget_simple_extent_dims(space, c.dims.data(), nullptr);
+  H5Sclose(space);
+  const hid_t type = H5Dget_type(ds);
+  c.type_ok = H5Tequal(type, expected_type) > 0;
+  H5Tclose(type);
+  H5Dclose(ds);
+  return c;
+}
+
+// The attribute's type class, or -1 when it is missing.
+int attribute_class(hid_t group, const char* name) {
+  if (H5Aexists(group, name) <= 0) return -1;
+  const hid_t a = H5Aopen(group, name, H5P_DEFAULT);
+  if (a < 0) return -1;
+  const hid_t t = H5Aget_type(a);
+  const int c = static_cast<int>(H5Tget_class(t));
+  H5Tclose(t);
+  H5Aclose(a);
+  return c;
+}
+
+// The run of the basic test (not quiet), made once: the physics test looks at it too.
+struct BasicRun {
+  std::string path;
+  std::vector<std::string> files;  // in its directory afterwards
+  CommandResult result;
+  Bundle before, after;
+};
+
+const BasicRun& basic_run() {
+  static BasicRun run;
+  static bool done = false;
+  if (done) return run;
+  done = true;
+  const std::string& input = input_bundle(kBasicEdges, kBasicSeed, "table.json");
+  run.before = read_bundle(input);
+  const std::string dir = fresh_dir("basic");
+  run.path = dir + "/b.h5";
+  copy_bundle(input, run.path);
+  run.result = perturb_tool({"--bundle", run.path, "--perturbations", std::to_string(kBasicP), "--threads", "2"});
+  run.files = files_in(dir);
+  run.after = read_bundle(run.path);
+  return run;
+}
+
+TEST(PerturbCli, BasicRunWritesConsistentProbabilities) {
+  const BasicRun& run = basic_run();
+  const Bundle& before = run.before;
+  const CommandResult& r = run.result;
+  const std::string& path = run.path;
+  ASSERT_EQ(before.size(), kBasicEdges);
+  ASSERT_FALSE(before.perturbation.present);
+  ASSERT_EQ(r.exit_code, 0) << describe(r);
+  EXPECT_EQ(run.files, std::vector<std::string>{"b.h5"});
+
+  const Bundle& after = run.after;
+  expect_same_edges(after, before);
+  const Perturbation& p = after.perturbation;
+  ASSERT_TRUE(p.present);
+  EXPECT_TRUE(p.complete);
+  EXPECT_TRUE(same_double(p.theta, before.header.design_theta))
+      << "theta " << p.theta << " is not the bundle's design theta " << before.header.design_theta;
+  EXPECT_EQ(p.perturbations, kBasicP);
+  EXPECT_EQ(p.seed, 1u) << "the default seed";
+  EXPECT_GT(p.simulated_seconds, 0);
+  EXPECT_GT(p.wall_seconds, 0);
+  EXPECT_EQ(check_invariants(after), kBasicEdges);
+  for (size_t e = 0; e < after.size(); ++e) {
+    ASSERT_EQ(p.done[e], kBasicP) << "edge " << e;
+  }
+
+  // The layout of /perturbation, with the HDF5 C API.
+  {
+    H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+    const hid_t file = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+    ASSERT_GE(file, 0) << path;
+    const hid_t g = H5Gopen2(file, "/perturbation", H5P_DEFAULT);
+    EXPECT_GE(g, 0) << "/perturbation is not a group";
+    if (g >= 0) {
+      EXPECT_EQ(attribute_class(g, "complete"), H5T_INTEGER);
+      EXPECT_EQ(attribute_class(g, "theta"), H5T_FLOAT);
+      EXPECT_EQ(attribute_class(g, "perturbations"), H5T_INTEGER);
+      EXPECT_EQ(attribute_class(g, "seed"), H5T_INTEGER);
+      EXPECT_EQ(attribute_class(g, "distribution"), H5T_STRING);
+      EXPECT_EQ(attribute_class(g, "wall_seconds"), H5T_FLOAT);
+      EXPECT_EQ(attribute_class(g, "simulated_seconds"), H5T_FLOAT);
+      H5Gclose(g);
+    }
+    const struct {
+      const char* name;
+      hid_t type;
+    } expected[] = {
+        {"/perturbation/done", H5T_STD_U64LE},        {"/perturbation/valid", H5T_STD_U64LE},
+        {"/perturbation/lazy", H5T_STD_U64LE},        {"/perturbation/collision", H5T_STD_U64LE},
+        {"/perturbation/max_error", H5T_IEEE_F64LE},  {"/perturbation/p_lazy_prop", H5T_IEEE_F64LE},
+        {"/perturbation/p_collision", H5T_IEEE_F64LE},
+    };
+    for (const auto& e : expected) {
+      SCOPED_TRACE(e.name);
+      const Hdf5Check c = dataset_check(file, e.name, e.type);
+      ASSERT_TRUE(c.exists);
+      EXPECT_TRUE(c.type_ok) << "element type";
+      EXPECT_EQ(c.dims, std::vector<hsize_t>{kBasicEdges});
+    }
+    H5Fclose(file);
+  }
+
+  // The summary on stdout: both histograms (10 bins each) and the share of usable edges.
+  EXPECT_TRUE(contains(r.out, "P_lazy_prop")) << r.out;
+  EXPECT_TRUE(contains(r.out, "P_collision")) << r.out;
+  EXPECT_TRUE(contains(r.out, "usable for lazy propagation")) << r.out;
+  std::istringstream lines(r.out);
+  std::string line;
+  int bins = 0, last_bins = 0;
+  while (std::getline(lines, line)) {
+    const size_t first = line.find_first_not_of(' ');
+    if (first != std::string::npos && line[first] == '[') ++bins;
+    if (contains(line, "1.000]")) ++last_bins;
+  }
+  EXPECT_EQ(bins, 20) << "expected two 10-bin histograms:\n" << r.out;
+  EXPECT_EQ(last_bins, 2) << "expected two histograms ending at 1:\n" << r.out;
+  EXPECT_FALSE(contains(r.err, "error")) << r.err;
+}
+
+// ------------------------------------------------------------------------------------------
+// 2. Determinism
+// ------------------------------------------------------------------------------------------
+
+constexpr uint64_t kSmallEdges = 120, kSmallSeed = 22;
+
+TEST(PerturbCli, SameNumbersWhateverTheThreadCount) {
+  const std::string& input = input_bundle(kSmallEdges, kSmallSeed);
+  const std::string dir = fresh_dir("threads");
+  const std::string one = dir + "/one.h5";
+  copy_bundle(input, one);
+  const CommandResult r = perturb_tool({"--bundle", one, "--perturbations", "4", "--seed", "3", "--threads", "1", "--quiet"});
+  ASSERT_EQ(r.exit_code, 0) << describe(r);
+  EXPECT_EQ(r.out, "");
+  EXPECT_EQ(r.err, "");
+  const Bundle a = read_bundle(one);
+  const Bundle& b = reference(input, {"--perturbations", "4", "--seed", "3"});  // 2 threads
+  EXPECT_TRUE(a.perturbation.complete);
+  EXPECT_EQ(check_invariants(a), kSmallEdges);
+  expect_same_perturbation(a.perturbation, b.perturbation);
+  EXPECT_TRUE(same_double(a.perturbation.simulated_seconds, b.perturbation.simulated_seconds))
+      << "same split, same sum expected";
+  expect_same_edges(a, b);
+}
+
+// ------------------------------------------------------------------------------------------
+// 3. Extending, re-running, refusing, replacing
+// ------------------------------------------------------------------------------------------
+
+TEST(PerturbCli, ExtendRerunRefuseAndReplace) {
+  const std::string& input = input_bundle(kSmallEdges, kSmallSeed);
+  const Bundle original = read_bundle(input);
+  const std::string dir = fresh_dir("extend");
+  const std::string path = dir + "/b.h5";
+  copy_bundle(input, path);
+
+  // p = 4, then p = 8 with the same seed and theta: equal to a fresh p = 8 run.
+  {
+    const CommandResult r4 = perturb_tool({"--bundle", path, "--perturbations", "4", "--seed", "3", "--threads", "2", "--quiet"});
+    ASSERT_EQ(r4.exit_code, 0) << describe(r4);
+    const Bundle b4 = read_bundle(path);
+    EXPECT_EQ(b4.perturbation.perturbations, 4u);
+    expect_same_perturbation(b4.perturbation, reference(input, {"--perturbations", "4", "--seed", "3"}).perturbation);
+    const CommandResult r8 = perturb_tool({"--bundle", path, "--perturbations", "8", "--seed", "3", "--threads", "2", "--quiet"});
+    ASSERT_EQ(r8.exit_code, 0) << describe(r8);
+    const Bundle b8 = read_bundle(path);
+    EXPECT_TRUE(b8.perturbation.complete);
+    EXPECT_EQ(check_invariants(b8), kSmallEdges);
+    expect_same_perturbation(b8.perturbation, reference(input, {"--perturbations", "8", "--seed", "3"}).perturbation);
+    expect_same_edges(b8, original);
+  }
+
+  // The same settings again on a complete analysis: says so, changes nothing.
+  {
+    const Bundle before = read_bundle(path);
+    const CommandResult again = perturb_tool({"--bundle", path, "--perturbations", "8", "--seed", "3", "--threads", "2"});
+    ASSERT_EQ(again.exit_code, 0) << describe(again);
+    EXPECT_TRUE(contains(again.err, "already")) << describe(again);
+    EXPECT_TRUE(contains(again.err, path)) << describe(again);
+    const Bundle after = read_bundle(path);
+    expect_same_perturbation(after.perturbation, before.perturbation, /*work=*/true);
+    expect_same_edges(after, original);
+    EXPECT_TRUE(tmp_files_in(dir).empty()) << join(tmp_files_in(dir));
+  }
+
+  // Refusals: one line naming the file and how to get past it, the file's bytes unchanged.
+  const struct {
+    const char* name;
+    std::vector<std::string> args;
+    std::vector<std::string> needles;
+  } refusals[] = {
+      {"fewer perturbations", {"--perturbations", "4", "--seed", "3"}, {"--replace"}},
+      {"another theta", {"--perturbations", "8", "--seed", "3", "--theta", "0.3"}, {"--replace", "theta"}},
+      {"another seed", {"--perturbations", "8", "--seed", "4"}, {"--replace", "--seed"}},
+      {"another seed and more perturbations", {"--perturbations", "12", "--seed", "4"}, {"--replace", "--seed"}},
+  };
+  for (const auto& refusal : refusals) {
+    SCOPED_TRACE(refusal.name);
+    const auto before = snapshot(dir);
+    std::vector<std::string> args = {"--bundle", path, "--threads", "2"};
+    args.insert(args.end(), refusal.args.begin(), refusal.args.end());
+    const CommandResult r = perturb_tool(args, 20);
+    std::vector<std::string> needles = refusal.needles;
+    needles.push_back(path);
+    expect_one_line_error(r, needles);
+    EXPECT_EQ(r.exit_code, 1) << describe(r);
+    EXPECT_TRUE(snapshot(dir) == before) << "the directory changed: " << join(files_in(dir));
+  }
+
+  // --replace: equal to a fresh run with the new settings.
+  {
+    const CommandResult r = perturb_tool({"--bundle", path, "--replace", "--theta", "0.3", "--perturbations", "4", "--seed",
+                                          "3", "--threads", "2", "--quiet"});
+    ASSERT_EQ(r.exit_code, 0) << describe(r);
+    const Bundle b = read_bundle(path);
+    EXPECT_TRUE(same_double(b.perturbation.theta, 0.3));
+    expect_same_perturbation(b.perturbation,
+                             reference(input, {"--theta", "0.3", "--perturbations", "4", "--seed", "3"}).perturbation);
+    expect_same_edges(b, original);
+  }
+  {
+    // Back to the design theta (not given: the default) with another seed.
+    const CommandResult r = perturb_tool({"--bundle", path, "--replace", "--perturbations", "4", "--seed", "4", "--threads",
+                                          "2", "--quiet"});
+    ASSERT_EQ(r.exit_code, 0) << describe(r);
+    const Bundle b = read_bundle(path);
+    EXPECT_TRUE(same_double(b.perturbation.theta, original.header.design_theta));
+    expect_same_perturbation(b.perturbation, reference(input, {"--perturbations", "4", "--seed", "4"}).perturbation);
+    expect_same_edges(b, original);
+    // A different seed gives different perturbations (the counts of some edge differ).
+    const Perturbation& s3 = reference(input, {"--perturbations", "4", "--seed", "3"}).perturbation;
+    EXPECT_FALSE(same_array("max_error", b.perturbation.max_error, s3.max_error)) << "seeds 3 and 4 gave the same errors";
+  }
+  EXPECT_TRUE(tmp_files_in(dir).empty()) << join(tmp_files_in(dir));
+}
+
+// ------------------------------------------------------------------------------------------
+// 4. Interruption and resume
+// ------------------------------------------------------------------------------------------
+
+constexpr uint64_t kLongEdges = 200, kLongSeed = 23;
+// Not representable in 6 significant digits: the hint must give it back exactly.
+constexpr double kLongTheta = 0.3141592653589793;
+const char* const kLongThetaText = "0.3141592653589793";
+
+std::vector<std::string> long_args(const std::string& path) {
+  return {"--bundle", path, "--perturbations", "16", "--theta", kLongThetaText, "--seed", "5", "--threads", "2", "--quiet"};
+}
+
+const Bundle& long_reference() {
+  return reference(input_bundle(kLongEdges, kLongSeed),
+                   {"--perturbations", "16", "--theta", kLongThetaText, "--seed", "5"});
+}
+
+// Splits a command line at spaces (the hint's paths have none here).
+std::vector<std::string> words_of(const std::string& s) {
+  std::istringstream in(s);
+  std::vector<std::string> out;
+  std::string w;
+  while (in >> w) out.push_back(w);
+  return out;
+}
+
+TEST(PerturbCli, InterruptedRunResumesToTheUninterruptedResult) {
+  const std::string& input = input_bundle(kLongEdges, kLongSeed);
+  const Bundle original = read_bundle(input);
+  const Bundle& straight = long_reference();
+  const std::string dir = fresh_dir("sigint");
+  const std::string path = dir + "/run.h5";
+  copy_bundle(input, path);
+  const ino_t inode = inode_of(path);
+
+  std::vector<std::string> args = long_args(path);
+  args.insert(args.end(), {"--checkpoint-seconds", "0.5"});
+  Background b = spawn_perturb(args, temp_dir() + "/sigint");
+  ASSERT_GT(b.pid, 0);
+  // A first checkpoint proves that work was done and the signal handlers are installed; then
+  // Ctrl-C about 1.5 s into the run.
+  int early_exit = -1000;
+  const bool checkpointed = wait_for_checkpoint(b, path, inode, 60, early_exit);
+  if (b.pid > 0) {
+    sleep_until(std::max(Clock::now(), b.started + std::chrono::milliseconds(1500)));
+    ::kill(b.pid, SIGINT);
+  }
+  const int code = b.pid > 0 ? wait_for(b) : early_exit;
+  ASSERT_TRUE(checkpointed) << "no checkpoint before the run ended (exit " << code << "): make the run longer\n"
+                            << read_file(b.err_path);
+  const std::string err = read_file(b.err_path);
+  EXPECT_EQ(code, 130) << err;
+  EXPECT_EQ(read_file(b.out_path), "") << "--quiet printed on stdout";
+  EXPECT_EQ(count_lines(err), 1) << "expected a one-line hint on stderr:\n" << err;
+  EXPECT_TRUE(contains(err, path)) << err;
+  EXPECT_TRUE(tmp_files_in(dir).empty()) << join(tmp_files_in(dir));
+
+  // The hint is a command that continues this very analysis.
+  {
+    const size_t at = err.find("lazyboe-perturb --bundle");
+    ASSERT_NE(at, std::string::npos) << "no command to continue in:\n" << err;
+    const std::vector<std::string> words = words_of(err.substr(at));
+    std::map<std::string, std::string> options;
+    for (size_t i = 1; i + 1 < words.size(); i += 2) options[words[i]] = words[i + 1];
+    EXPECT_EQ(options["--bundle"], path) << err;
+    EXPECT_EQ(options["--perturbations"], "16") << err;
+    EXPECT_EQ(options["--seed"], "5") << err;
+    const std::string theta = options["--theta"];
+    EXPECT_TRUE(theta.empty() || std::strtod(theta.c_str(), nullptr) == kLongTheta)
+        << "the hint's --theta " << theta << " is not the theta of the run (" << kLongThetaText
+        << "): its command would be refused as another theta\n"
+        << err;
+  }
+
+  const Bundle partial = read_bundle(path);
+  expect_same_edges(partial, original);
+  ASSERT_TRUE(partial.perturbation.present);
+  EXPECT_FALSE(partial.perturbation.complete);
+  EXPECT_TRUE(same_double(partial.perturbation.theta, kLongTheta));
+  EXPECT_EQ(partial.perturbation.perturbations, 16u);
+  EXPECT_EQ(partial.perturbation.seed, 5u);
+  const size_t finished = check_invariants(partial);
+  EXPECT_GT(finished, 0u);
+  EXPECT_LT(finished, kLongEdges);
+  // The edges done so far already hold their final numbers.
+  for (size_t e = 0; e < partial.size(); ++e) {
+    if (partial.perturbation.done[e] == 0) continue;
+    ASSERT_EQ(partial.perturbation.lazy[e], straight.perturbation.lazy[e]) << "edge " << e;
+    ASSERT_EQ(partial.perturbation.collision[e], straight.perturbation.collision[e]) << "edge " << e;
+  }
+
+  // The same command again completes it.
+  const CommandResult resumed = perturb_tool(args);
+  ASSERT_EQ(resumed.exit_code, 0) << describe(resumed);
+  EXPECT_EQ(resumed.out, "");
+  EXPECT_EQ(resumed.err, "");
+  EXPECT_TRUE(tmp_files_in(dir).empty()) << join(tmp_files_in(dir));
+  const Bundle full = read_bundle(path);
+  EXPECT_TRUE(full.perturbation.complete);
+  EXPECT_EQ(check_invariants(full), kLongEdges);
+  expect_same_perturbation(full.perturbation, straight.perturbation);
+  expect_same_edges(full, original);
+  EXPECT_GE(full.perturbation.wall_seconds, partial.perturbation.wall_seconds) << "work time of the first part lost";
+}
+
+TEST(PerturbCli, KilledRunLeavesAValidResumableBundle) {
+  const std::string& input = input_bundle(kLongEdges, kLongSeed);
+  const Bundle original = read_bundle(input);
+  const std::string dir = fresh_dir("sigkill");
+  const std::string path = dir + "/run.h5";
+  copy_bundle(input, path);
+  const ino_t inode = inode_of(path);
+
+  std::vector<std::string> args = long_args(path);
+  args.insert(args.end(), {"--checkpoint-seconds", "0.2"});
+  Background b = spawn_perturb(args, temp_dir() + "/sigkill");
+  ASSERT_GT(b.pid, 0);
+  const pid_t pid = b.pid;
+  int early_exit = -1000;
+  const bool checkpointed = wait_for_checkpoint(b, path, inode, 60, early_exit);
+  if (b.pid > 0) {
+    sleep_seconds(0.5);  // a few more checkpoints: the kill may well land inside one
+    ::kill(b.pid, SIGKILL);
+  }
+  const int code = b.pid > 0 ? wait_for(b) : early_exit;
+  ASSERT_TRUE(checkpointed) << "no checkpoint before the run ended (exit " << code << ")\n" << read_file(b.err_path);
+  ASSERT_EQ(code, -SIGKILL) << "the run ended before the kill: make it longer\n" << read_file(b.err_path);
+
+  // Only the killed process's own temporary file may remain.
+  const std::string own_tmp = "run.h5.tmp." + std::to_string(pid);
+  for (const std::string& f : tmp_files_in(dir)) EXPECT_EQ(f, own_tmp);
+
+  const Bundle partial = read_bundle(path);  // throws (fails the test) if the kill broke it
+  expect_same_edges(partial, original);
+  ASSERT_TRUE(partial.perturbation.present);
+  EXPECT_FALSE(partial.perturbation.complete);
+  const size_t finished = check_invariants(partial);
+  EXPECT_GT(finished, 0u);
+  EXPECT_LT(finished, kLongEdges);
+
+  const CommandResult resumed = perturb_tool(args);  // the same command again
+  ASSERT_EQ(resumed.exit_code, 0) << describe(resumed);
+  const Bundle full = read_bundle(path);
+  EXPECT_TRUE(full.perturbation.complete);
+  expect_same_perturbation(full.perturbation, long_reference().perturbation);
+  expect_same_edges(full, original);
+}
+
+// ------------------------------------------------------------------------------------------
+// 5. Refusals
+// ------------------------------------------------------------------------------------------
+
+enum class Exit { One, CommandLine, Either };  // 1; >= 2 (CLI11); either of them
+
+struct BadCase {
+  std::string name;
+  std::vector<std::string> args;     // @BUNDLE: the copied bundle; @DIR: the case's directory
+  std::vector<std::string> needles;  // all must appear in the one line on stderr
+  Exit exit = Exit::One;
+  std::function<void(const std::string& dir)> setup = nullptr;
+};
+
+std::string expand(const std::string& s, const std::string& dir) {
+  if (s.rfind("@BUNDLE", 0) == 0) return dir + "/b.h5" + s.substr(7);
+  if (s.rfind("@DIR", 0) == 0) return dir + s.substr(4);
+  return s;
+}
+
+void expect_refused(const BadCase& c, const std::string& input, const std::string& dir_name) {
+  SCOPED_TRACE(c.name);
+  const std::string dir = fresh_dir(dir_name);
+  copy_bundle(input, dir + "/b.h5");
+  if (c.setup) c.setup(dir);
+  const auto before = snapshot(dir);
+  std::vector<std::string> args, needles;
+  for (const std::string& a : c.args) args.push_back(expand(a, dir));
+  for (const std::string& n : c.needles) needles.push_back(expand(n, dir));
+  const CommandResult r = perturb_tool_in(dir, args);
+  expect_one_line_error(r, needles);
+  switch (c.exit) {
+    case Exit::One: EXPECT_EQ(r.exit_code, 1) << describe(r); break;
+    case Exit::CommandLine: EXPECT_GE(r.exit_code, 2) << describe(r); break;
+    case Exit::Either: EXPECT_GE(r.exit_code, 1) << describe(r); break;
+  }
+  const auto after = snapshot(dir);
+  std::vector<std::string> names_before, names_after;
+  for (const auto& [name, bytes] : before) names_before.push_back(name);
+  for (const auto& [name, bytes] : after) names_after.push_back(name);
+  EXPECT_EQ(names_after, names_before) << "files written or removed";
+  EXPECT_TRUE(after == before) << "a file was changed";
+}
+
+// A copy of the Panda's config and URDF in `dir`; `edit` may change the URDF text.
+void copy_robot(const std::string& dir, const std::function<void(std::string&)>& edit = nullptr) {
+  fs::copy_file(source_path("data/robots/panda.json"), dir + "/panda.json", fs::copy_options::overwrite_existing);
+  std::string urdf = read_file(source_path("data/robots/panda.urdf"));
+  if (edit) edit(urdf);
+  write_bytes(dir + "/panda.urdf", urdf);
+}
+
+// One mass of the URDF, changed: 0.629769 -> 0.639769 kg (still a perfectly valid robot).
+void change_a_mass(std::string& urdf) {
+  const std::string from = "<mass value=\"0.629769\"/>", to = "<mass value=\"0.639769\"/>";
+  const size_t at = urdf.find(from);
+  ASSERT_NE(at, std::string::npos) << "test setup: the URDF has no mass 0.629769 any more";
+  urdf.replace(at, from.size(), to);
+}
+
+constexpr uint64_t kTinyEdges = 100, kTinySeed = 24;
+
+TEST(PerturbCli, BadInputIsOneLineAndChangesNothing) {
+  const std::string& input = input_bundle(kTinyEdges, kTinySeed);
+  const std::vector<BadCase> cases = {
+      {"missing --bundle", {"--perturbations", "4"}, {"--bundle"}, Exit::CommandLine},
+      {"missing file", {"--bundle", "@DIR/missing.h5"}, {"@DIR/missing.h5"}},
+      {"not an HDF5 file",
+       {"--bundle", "@DIR/garbage.h5"},
+       {"@DIR/garbage.h5"},
+       Exit::One,
+       [](const std::string& dir) { write_bytes(dir + "/garbage.h5", garbage_bytes()); }},
+      {"empty file",
+       {"--bundle", "@DIR/empty.h5"},
+       {"@DIR/empty.h5"},
+       Exit::One,
+       [](const std::string& dir) { write_bytes(dir + "/empty.h5", ""); }},
+      {"incomplete bundle",
+       {"--bundle", "@DIR/incomplete.h5"},
+       {"@DIR/incomplete.h5", "lazyboe-build --resume"},
+       Exit::One,
+       [&input](const std::string& dir) {
+         Bundle b = read_bundle(input);
+         b.header.complete = false;
+         b.header.target_edges = 2 * b.size();
+         write_bundle(dir + "/incomplete.h5", b);
+       }},
+      {"another robot (one mass changed)",
+       {"--bundle", "@BUNDLE", "--robot", "@DIR/panda.json"},
+       {"@DIR/panda.json", "not the robot"},
+       Exit::One,
+       [](const std::string& dir) { copy_robot(dir, change_a_mass); }},
+      {"another environment", {"--bundle", "@BUNDLE", "--env", env_file("shelf.json")}, {"shelf.json", "not the environment"}},
+      {"missing robot file", {"--bundle", "@BUNDLE", "--robot", "@DIR/nope.json"}, {"@DIR/nope.json"}},
+      {"missing environment file", {"--bundle", "@BUNDLE", "--env", "@DIR/nope.json"}, {"@DIR/nope.json"}},
+      {"perturbations 0", {"--bundle", "@BUNDLE", "--perturbations", "0"}, {"--perturbations"}, Exit::CommandLine},
+      {"perturbations -1", {"--bundle", "@BUNDLE", "--perturbations", "-1"}, {"--perturbations"}, Exit::CommandLine},
+      {"perturbations abc", {"--bundle", "@BUNDLE", "--perturbations", "abc"}, {"--perturbations"}, Exit::CommandLine},
+      {"perturbations too many", {"--bundle", "@BUNDLE", "--perturbations", "16777216"}, {"--perturbations"}, Exit::Either},
+      {"theta -1", {"--bundle", "@BUNDLE", "--theta", "-1"}, {"--theta"}, Exit::Either},
+      {"theta 0", {"--bundle", "@BUNDLE", "--theta", "0"}, {"--theta"}, Exit::Either},
+      {"theta nan", {"--bundle", "@BUNDLE", "--theta", "nan"}, {"--theta"}, Exit::Either},
+      {"theta abc", {"--bundle", "@BUNDLE", "--theta", "abc"}, {"--theta"}, Exit::CommandLine},
+      {"seed -3", {"--bundle", "@BUNDLE", "--seed", "-3"}, {"--seed"}, Exit::CommandLine},
+      {"threads x", {"--bundle", "@BUNDLE", "--threads", "x"}, {"--threads"}, Exit::CommandLine},
+      {"checkpoint -1", {"--bundle", "@BUNDLE", "--checkpoint-seconds", "-1"}, {"--checkpoint-seconds"}, Exit::CommandLine},
+      {"unknown option", {"--bundle", "@BUNDLE", "--bogus"}, {"--bogus"}, Exit::CommandLine},
+  };
+  for (size_t k = 0; k < cases.size(); ++k) expect_refused(cases[k], input, "bad-" + std::to_string(k));
+}
+
+// The robot and environment are checked by content, not by path: identical copies elsewhere
+// are accepted, a copy with one number changed is not (above).
+TEST(PerturbCli, RobotAndEnvironmentAreCheckedByContent) {
+  const std::string& input = input_bundle(kTinyEdges, kTinySeed);
+  const std::string dir = fresh_dir("copies");
+  const std::string path = dir + "/b.h5";
+  copy_bundle(input, path);
+  copy_robot(dir);
+  fs::copy_file(env_file("table.json"), dir + "/table.json");
+  const CommandResult r = perturb_tool({"--bundle", path, "--robot", dir + "/panda.json", "--env", dir + "/table.json",
+                                        "--perturbations", "1", "--threads", "2", "--quiet"});
+  ASSERT_EQ(r.exit_code, 0) << describe(r);
+  const Bundle b = read_bundle(path);
+  EXPECT_TRUE(b.perturbation.complete);
+  EXPECT_EQ(check_invariants(b), kTinyEdges);
+  expect_same_perturbation(b.perturbation, reference(input, {"--perturbations", "1"}).perturbation);
+  expect_same_edges(b, read_bundle(input));
+}
+
+// ------------------------------------------------------------------------------------------
+// 6. Physics, in broad strokes (the library tests are finer)
+// ------------------------------------------------------------------------------------------
+
+TEST(PerturbCli, ProbabilitiesArePlausibleOnTheTable) {
+  const BasicRun& run = basic_run();
+  ASSERT_EQ(run.result.exit_code, 0) << describe(run.result);
+  const Bundle& b = run.after;
+  EXPECT_EQ(b.header.env_hash, run.before.header.env_hash);
+  EXPECT_TRUE(contains(b.header.env_file, "table.json")) << b.header.env_file;
+  const Perturbation& p = b.perturbation;
+  ASSERT_TRUE(p.complete);
+  ASSERT_EQ(p.p_collision.size(), kBasicEdges);
+  const double n = static_cast<double>(kBasicEdges);
+  const double mean_collision = std::accumulate(p.p_collision.begin(), p.p_collision.end(), 0.0) / n;
+  const double mean_lazy = std::accumulate(p.p_lazy_prop.begin(), p.p_lazy_prop.end(), 0.0) / n;
+  EXPECT_GT(mean_collision, 0) << "no perturbation of any edge collides with the table";
+  EXPECT_LT(mean_collision, 0.5);
+  // Half of the perturbations have |d| < theta/2; an end that moves with the start keeps that.
+  EXPECT_GT(mean_lazy, 0.3);
+  EXPECT_LT(mean_lazy, 0.7);
+  uint64_t valid = 0, lazy = 0, collision = 0, done = 0;
+  for (size_t e = 0; e < b.size(); ++e) {
+    valid += p.valid[e];
+    lazy += p.lazy[e];
+    collision += p.collision[e];
+    done += p.done[e];
+  }
+  EXPECT_EQ(done, kBasicEdges * kBasicP);
+  EXPECT_GT(valid, done / 2) << "most perturbations should re-simulate validly";
+  EXPECT_GT(lazy, 0u);
+  EXPECT_LT(lazy, valid);
+  EXPECT_GT(collision, 0u);
+  std::printf("[ info     ] mean P_collision %.3f, mean P_lazy_prop %.3f, rollouts valid %.1f%%, collided %.1f%%\n",
+              mean_collision, mean_lazy, 100.0 * valid / done, 100.0 * collision / done);
+}
+
+}  // namespace
+}  // namespace lazyboe::test
