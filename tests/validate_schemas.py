@@ -9,15 +9,26 @@ import jsonschema
 root = pathlib.Path(sys.argv[1])
 cases = [("schemas/robot-config.schema.json", p) for p in sorted((root / "data/robots").glob("*.json"))]
 cases += [("schemas/environment.schema.json", p) for p in sorted((root / "data/environments").glob("*.json"))]
+for path in sorted((root / "data/queries").glob("*.jsonl")):
+    schema = json.loads((root / "schemas/query.schema.json").read_text())
+    for n, line in enumerate(path.read_text().splitlines(), 1):
+        if line.strip():
+            cases.append(("schemas/query.schema.json", (path, n, json.loads(line))))
 passed = failed = 0
 for schema_path, data_path in cases:
     schema = json.loads((root / schema_path).read_text())
     jsonschema.Draft202012Validator.check_schema(schema)
-    errors = list(jsonschema.Draft202012Validator(schema).iter_errors(json.loads(data_path.read_text())))
+    if isinstance(data_path, tuple):
+        data_path, line, doc = data_path
+        name = f"{data_path.relative_to(root)}:{line}"
+    else:
+        doc = json.loads(data_path.read_text())
+        name = str(data_path.relative_to(root))
+    errors = list(jsonschema.Draft202012Validator(schema).iter_errors(doc))
     if errors:
         failed += 1
         for e in errors:
-            print(f"{data_path.relative_to(root)}: {'/'.join(map(str, e.path))}: {e.message}")
+            print(f"{name}: {'/'.join(map(str, e.path))}: {e.message}")
     else:
         passed += 1
 print(f"{passed} passed, {failed} failed")
