@@ -11,17 +11,9 @@
 #include <random>
 
 #include "robot/dynamics.h"
+#include "alloc_counter.h"
 #include "test_util.h"
 
-// Counts every operator new in this test binary, to prove the hot paths allocate nothing.
-static std::atomic<long> g_allocations{0};
-void* operator new(std::size_t size) {
-  ++g_allocations;
-  if (void* p = std::malloc(size ? size : 1)) return p;
-  throw std::bad_alloc();
-}
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
 
 namespace lazyboe {
 namespace {
@@ -282,7 +274,7 @@ TEST(Dynamics, HotPathsDoNotAllocate) {
   std::mt19937_64 rng(18);
   const State s = random_state(robot, rng);
   JointVector tau(7);
-  const long before = g_allocations.load();
+  const long before = test::allocations.load();
   for (int k = 0; k < 10; ++k) {
     forward_kinematics(robot, data, s.q);
     tau = inverse_dynamics(robot, data, s.q, s.dq, s.ddq);
@@ -290,7 +282,7 @@ TEST(Dynamics, HotPathsDoNotAllocate) {
     gravity_torques(robot, data, s.q);
     forward_dynamics(robot, data, s.q, s.dq, tau);
   }
-  EXPECT_EQ(g_allocations.load() - before, 0);
+  EXPECT_EQ(test::allocations.load() - before, 0);
 }
 
 }  // namespace

@@ -9,30 +9,14 @@
 
 #include "bundle/builder.h"
 #include "sim/simulator.h"
+#include "alloc_counter.h"
 #include "test_util.h"
 
-static std::atomic<long> g_allocations{0};
-void* operator new(std::size_t size) {
-  ++g_allocations;
-  if (void* p = std::malloc(size ? size : 1)) return p;
-  throw std::bad_alloc();
-}
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
 
 namespace lazyboe {
 namespace {
 
-struct Scene {
-  RobotModel robot = test::panda();
-  Environment env;
-  CollisionModel collision;
-  Simulator sim;
-  explicit Scene(const std::string& env_name, SimulationOptions options = {})
-      : env(load_environment(test::source_path("data/environments/" + env_name + ".json"))),
-        collision(build_collision_model(robot, env)),
-        sim(robot, collision, options) {}
-};
+using test::Scene;
 
 BuildSettings default_settings(const RobotModel& robot) {
   BuildSettings s;
@@ -219,9 +203,9 @@ TEST(Simulator, RolloutAllocatesNothingWithReservedSamples) {
   e.sample_q.reserve(4096);
   e.sample_dq.reserve(4096);
   generate_edge(scene.sim, ws, settings, 0, e);  // warm-up sizes q0/qf
-  const long before = g_allocations.load();
+  const long before = test::allocations.load();
   for (uint64_t a = 1; a < 20; ++a) generate_edge(scene.sim, ws, settings, a, e);
-  EXPECT_EQ(g_allocations.load() - before, 0);
+  EXPECT_EQ(test::allocations.load() - before, 0);
 }
 
 // The bundle's contents depend only on (seed, attempt): any thread count, and a build stopped

@@ -23,6 +23,12 @@ const RobotModel& panda() {
   return model;
 }
 
+Scene::Scene(const std::string& env_name, SimulationOptions options)
+    : robot(panda()),
+      env(load_environment(source_path("data/environments/" + env_name + ".json"))),
+      collision(build_collision_model(robot, env)),
+      sim(robot, collision, options) {}
+
 namespace {
 struct TempDir {
   std::string path;

@@ -5,6 +5,7 @@
 
 #include "collision/collision_model.h"
 #include "robot/robot_model.h"
+#include "sim/simulator.h"
 
 namespace lazyboe::test {
 
@@ -12,6 +13,17 @@ std::string source_path(const std::string& relative);  // inside the repository
 std::string tool_path(const std::string& tool);         // build/bin/<tool>
 
 const RobotModel& panda();  // loaded once per test binary
+
+// The bundled Panda in one of the bundled environments, with a simulator over them.
+struct Scene {
+  explicit Scene(const std::string& env_name, SimulationOptions options = {});
+  Scene(const Scene&) = delete;
+  Scene& operator=(const Scene&) = delete;
+  RobotModel robot;
+  Environment env;
+  CollisionModel collision;
+  Simulator sim;
+};
 
 // A fresh directory under the system temp dir, removed at exit.
 std::string temp_dir();

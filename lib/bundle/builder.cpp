@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <sstream>
 
+#include "common/checkpoint.h"
 #include "common/error.h"
 #include "common/hash.h"
 #include "common/progress.h"
@@ -210,15 +211,13 @@ BuildOutcome build_bundle(const Simulator& sim, const BuildSettings& settings, B
 
   Progress progress("lazyboe-build", settings.edges, control.quiet);
   const double wall_before = h.wall_seconds;
-  auto last_checkpoint = std::chrono::steady_clock::now();
-  double checkpoint_cost = 0;
+  Checkpointer checkpoints(control.checkpoint_seconds, [&] {
+    h.wall_seconds = wall_before + progress.elapsed();
+    if (control.save_checkpoint) control.save_checkpoint(bundle);
+  });
   auto save = [&](bool complete) {
     h.complete = complete;
-    h.wall_seconds = wall_before + progress.elapsed();
-    const auto t0 = std::chrono::steady_clock::now();
-    if (control.save_checkpoint) control.save_checkpoint(bundle);
-    last_checkpoint = std::chrono::steady_clock::now();
-    checkpoint_cost = std::chrono::duration<double>(last_checkpoint - t0).count();
+    checkpoints.save_now();
   };
   auto status_line = [&]() { return "valid " + percent(h.valid, h.attempts); };
 
@@ -248,11 +247,7 @@ BuildOutcome build_bundle(const Simulator& sim, const BuildSettings& settings, B
       }
     }
     progress.update(bundle.size(), status_line());
-    const double since = std::chrono::duration<double>(std::chrono::steady_clock::now() - last_checkpoint).count();
-    // Checkpoints cost a whole-file rewrite: keep them to a small share of the time.
-    if (bundle.size() < settings.edges && since >= std::max(control.checkpoint_seconds, 10 * checkpoint_cost)) {
-      save(false);
-    }
+    if (bundle.size() < settings.edges) checkpoints.save_if_due();
   }
   progress.finish();
   save(true);

@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <limits>
 
+#include "common/checkpoint.h"
 #include "common/error.h"
 #include "common/progress.h"
 #include "sim/random.h"
@@ -118,15 +119,13 @@ PerturbOutcome run_perturbation(const Simulator& sim, Bundle& b, const PerturbSe
   }
   Progress progress("lazyboe-perturb", n, control.quiet);
   const double wall_before = p.wall_seconds;
-  auto last_checkpoint = std::chrono::steady_clock::now();
-  double checkpoint_cost = 0;
+  Checkpointer checkpoints(control.checkpoint_seconds, [&] {
+    p.wall_seconds = wall_before + progress.elapsed();
+    if (control.save_checkpoint) control.save_checkpoint(b);
+  });
   auto save = [&](bool complete) {
     p.complete = complete;
-    p.wall_seconds = wall_before + progress.elapsed();
-    const auto t0 = std::chrono::steady_clock::now();
-    if (control.save_checkpoint) control.save_checkpoint(b);
-    last_checkpoint = std::chrono::steady_clock::now();
-    checkpoint_cost = std::chrono::duration<double>(last_checkpoint - t0).count();
+    checkpoints.save_now();
   };
   size_t finished = n - pending.size();
   const size_t round = std::max<size_t>(16, 8 * static_cast<size_t>(threads));
@@ -164,9 +163,7 @@ PerturbOutcome run_perturbation(const Simulator& sim, Bundle& b, const PerturbSe
     }
     finished += count;
     progress.update(finished);
-    const double since =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - last_checkpoint).count();
-    if (finished < n && since >= std::max(control.checkpoint_seconds, 10 * checkpoint_cost)) save(false);
+    if (finished < n) checkpoints.save_if_due();
   }
   progress.finish();
   save(true);

@@ -20,6 +20,7 @@ struct Node {
   double h = 0;        // heuristic: distance to the goal
   bool lazy = false;
   bool dead = false;   // failed simulation (lazy chains) or pruned (SST)
+  bool inactive = false;  // SST: no longer the representative of its witness
   bool expanded = false;
 };
 
@@ -351,15 +352,12 @@ class TreeSearch {
     for (int i = 0; i < x.size(); ++i) x[i] = rng_.uniform(p.sample_lower[i], p.sample_upper[i]);
   }
 
-  bool active(int v) const { return !s_nodes_const()[v].dead && !s_nodes_const()[v].lazy; }
-  const std::vector<Node>& s_nodes_const() const { return const_cast<SearchState&>(s_).nodes(); }
-
   int nearest(const JointVector& x) {
     int best = 0;
     double best_d = std::numeric_limits<double>::infinity();
     const std::vector<Node>& nodes = s_.nodes();
     for (size_t v = 0; v < nodes.size(); ++v) {
-      if (nodes[v].dead || nodes[v].lazy) continue;  // SST: `lazy` marks inactive nodes
+      if (nodes[v].dead || nodes[v].inactive) continue;
       const double d = (nodes[v].q - x).squaredNorm();
       if (d < best_d) {
         best_d = d;
@@ -375,7 +373,7 @@ class TreeSearch {
     double best_cost = std::numeric_limits<double>::infinity();
     const std::vector<Node>& nodes = s_.nodes();
     for (size_t v = 0; v < nodes.size(); ++v) {
-      if (nodes[v].dead || nodes[v].lazy) continue;
+      if (nodes[v].dead || nodes[v].inactive) continue;
       if ((nodes[v].q - x).norm() <= delta_bn && nodes[v].cost < best_cost) {
         best_cost = nodes[v].cost;
         best = static_cast<int>(v);
@@ -400,8 +398,8 @@ class TreeSearch {
   // The old representative becomes inactive; inactive leaves are removed, recursively upwards.
   void deactivate(int v) {
     std::vector<Node>& nodes = s_.nodes();
-    nodes[v].lazy = true;  // inactive
-    while (v > 0 && nodes[v].lazy && !nodes[v].dead && children_[v] == 0) {
+    nodes[v].inactive = true;
+    while (v > 0 && nodes[v].inactive && !nodes[v].dead && children_[v] == 0) {
       nodes[v].dead = true;
       const int parent = nodes[v].parent;
       --children_[parent];
