@@ -34,7 +34,8 @@ const RobotModel& robot() {
 // Uniform in [lo, hi] per joint.
 JointVector uniform(std::mt19937_64& rng, const JointVector& lo, const JointVector& hi) {
   JointVector v(lo.size());
-  for (int i = 0; i < lo.size(); ++i) v[i] = std::uniform_real_distribution<double>(lo[i], hi[i])(rng);
+  for (int i = 0; i < lo.size(); ++i)
+    v[i] = std::uniform_real_distribution<double>(lo[i], hi[i])(rng);
   return v;
 }
 
@@ -65,7 +66,7 @@ struct Scene {
   std::vector<JointVector> free_q;    // collision-free configurations only
   std::vector<JointVector> random_q;  // unfiltered
   double random_collision_fraction = 0;
-  double free_acceptance = 0;         // fraction of random draws that were collision-free
+  double free_acceptance = 0;  // fraction of random draws that were collision-free
 };
 
 bool check(const CollisionModel& model, RobotData& rd, CollisionData& cd, const JointVector& q) {
@@ -76,8 +77,12 @@ bool check(const CollisionModel& model, RobotData& rd, CollisionData& cd, const 
 
 Scene make_scene(const std::string& environment_file, std::uint64_t seed) {
   const RobotModel& m = robot();
-  Scene s{build_collision_model(m, load_environment(data_dir() + "/environments/" + environment_file)),
-          {}, {}, 0, 0};
+  Scene s{
+      build_collision_model(m, load_environment(data_dir() + "/environments/" + environment_file)),
+      {},
+      {},
+      0,
+      0};
   RobotData rd(m);
   CollisionData cd(s.model);
   std::mt19937_64 rng(seed);
@@ -168,7 +173,7 @@ BENCHMARK(BM_ForwardDynamics);
 
 // noinline: lets a profiler (callgrind --toggle-collect) isolate the timed loop from pool setup.
 [[gnu::noinline]] void run_collision_check(benchmark::State& state, const Scene& scene,
-                         const std::vector<JointVector>& pool) {
+                                           const std::vector<JointVector>& pool) {
   const RobotModel& m = robot();
   RobotData rd(m);
   CollisionData cd(scene.model);

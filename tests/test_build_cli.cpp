@@ -7,13 +7,12 @@
 // Run time matters (the whole file should stay well under a minute on two cores): builds use
 // a few hundred edges, except the interruption tests (2500 edges, a few seconds each).
 #include <fcntl.h>
+#include <gtest/gtest.h>
+#include <hdf5.h>
 #include <signal.h>
 #include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
-
-#include <gtest/gtest.h>
-#include <hdf5.h>
 
 #include <algorithm>
 #include <chrono>
@@ -54,7 +53,8 @@ std::string quote(const std::string& s) {
 // watchdog kills a run that does not end, so a tool that misreads its input fails the test
 // instead of hanging it.
 std::string build_command(const std::vector<std::string>& args, double timeout_seconds) {
-  std::string cmd = "timeout -s KILL " + std::to_string(timeout_seconds) + " " + quote(tool_path("lazyboe-build"));
+  std::string cmd = "timeout -s KILL " + std::to_string(timeout_seconds) + " " +
+                    quote(tool_path("lazyboe-build"));
   for (const std::string& a : args) cmd += " " + quote(a);
   return cmd;
 }
@@ -70,7 +70,8 @@ CommandResult build_tool_in(const std::string& dir, const std::vector<std::strin
 }
 
 std::string describe(const CommandResult& r) {
-  return "exit " + std::to_string(r.exit_code) + "\n--- stdout:\n" + r.out + "--- stderr:\n" + r.err;
+  return "exit " + std::to_string(r.exit_code) + "\n--- stdout:\n" + r.out + "--- stderr:\n" +
+         r.err;
 }
 
 long count_lines(const std::string& s) { return std::count(s.begin(), s.end(), '\n'); }
@@ -84,9 +85,11 @@ bool contains(const std::string& haystack, const std::string& needle) {
 void expect_one_line_error(const CommandResult& r, const std::vector<std::string>& needles) {
   std::string problems;
   if (r.exit_code == 0) problems += "  exit status 0 (expected failure)\n";
-  if (r.exit_code < 0 || r.exit_code >= 124) problems += "  exit status looks like a signal, crash or timeout\n";
+  if (r.exit_code < 0 || r.exit_code >= 124)
+    problems += "  exit status looks like a signal, crash or timeout\n";
   if (count_lines(r.err) != 1 || r.err.empty() || r.err.back() != '\n') {
-    problems += "  expected exactly one line on stderr, got " + std::to_string(count_lines(r.err)) + "\n";
+    problems +=
+        "  expected exactly one line on stderr, got " + std::to_string(count_lines(r.err)) + "\n";
   }
   if (!r.out.empty()) problems += "  stdout is not empty\n";
   for (const std::string& n : needles) {
@@ -154,8 +157,10 @@ Background spawn_build(const std::vector<std::string>& args, const std::string& 
   posix_spawn_file_actions_t actions;
   posix_spawn_file_actions_init(&actions);
   posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
-  posix_spawn_file_actions_addopen(&actions, 1, b.out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  posix_spawn_file_actions_addopen(&actions, 2, b.err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_addopen(&actions, 1, b.out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC,
+                                   0644);
+  posix_spawn_file_actions_addopen(&actions, 2, b.err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC,
+                                   0644);
   const int rc = posix_spawn(&b.pid, tool.c_str(), &actions, nullptr, argv.data(), environ);
   posix_spawn_file_actions_destroy(&actions);
   if (rc != 0) {
@@ -197,15 +202,18 @@ bool wait_for_file(const Background& b, const std::string& path, double timeout_
 
 // Bit-for-bit equality of two arrays, reporting the first difference.
 template <typename T>
-::testing::AssertionResult same_array(const std::string& name, const std::vector<T>& a, const std::vector<T>& b) {
+::testing::AssertionResult same_array(const std::string& name, const std::vector<T>& a,
+                                      const std::vector<T>& b) {
   if (a.size() != b.size()) {
-    return ::testing::AssertionFailure() << name << ": " << a.size() << " vs " << b.size() << " values";
+    return ::testing::AssertionFailure()
+           << name << ": " << a.size() << " vs " << b.size() << " values";
   }
   for (size_t i = 0; i < a.size(); ++i) {
     if (std::memcmp(&a[i], &b[i], sizeof(T)) != 0) {
       std::ostringstream o;
       o.precision(17);
-      o << name << ": first difference at element " << i << " of " << a.size() << ": " << a[i] << " vs " << b[i];
+      o << name << ": first difference at element " << i << " of " << a.size() << ": " << a[i]
+        << " vs " << b[i];
       return ::testing::AssertionFailure() << o.str();
     }
   }
@@ -244,16 +252,24 @@ void expect_same_header(const BundleHeader& a, const BundleHeader& b) {
   EXPECT_EQ(a.target_edges, b.target_edges);
   EXPECT_TRUE(same_array("region_lower", a.region_lower, b.region_lower));
   EXPECT_TRUE(same_array("region_upper", a.region_upper, b.region_upper));
-  EXPECT_TRUE(same_double(a.min_duration, b.min_duration)) << a.min_duration << " vs " << b.min_duration;
-  EXPECT_TRUE(same_double(a.max_duration, b.max_duration)) << a.max_duration << " vs " << b.max_duration;
-  EXPECT_TRUE(same_double(a.knot_interval, b.knot_interval)) << a.knot_interval << " vs " << b.knot_interval;
+  EXPECT_TRUE(same_double(a.min_duration, b.min_duration))
+      << a.min_duration << " vs " << b.min_duration;
+  EXPECT_TRUE(same_double(a.max_duration, b.max_duration))
+      << a.max_duration << " vs " << b.max_duration;
+  EXPECT_TRUE(same_double(a.knot_interval, b.knot_interval))
+      << a.knot_interval << " vs " << b.knot_interval;
   EXPECT_EQ(a.integrator, b.integrator);
   EXPECT_EQ(a.substeps, b.substeps);
-  EXPECT_TRUE(same_double(a.velocity_scale, b.velocity_scale)) << a.velocity_scale << " vs " << b.velocity_scale;
-  EXPECT_TRUE(same_double(a.limit_scale, b.limit_scale)) << a.limit_scale << " vs " << b.limit_scale;
-  EXPECT_TRUE(same_double(a.control_rate, b.control_rate)) << a.control_rate << " vs " << b.control_rate;
-  EXPECT_TRUE(same_double(a.sample_interval, b.sample_interval)) << a.sample_interval << " vs " << b.sample_interval;
-  EXPECT_TRUE(same_double(a.design_theta, b.design_theta)) << a.design_theta << " vs " << b.design_theta;
+  EXPECT_TRUE(same_double(a.velocity_scale, b.velocity_scale))
+      << a.velocity_scale << " vs " << b.velocity_scale;
+  EXPECT_TRUE(same_double(a.limit_scale, b.limit_scale))
+      << a.limit_scale << " vs " << b.limit_scale;
+  EXPECT_TRUE(same_double(a.control_rate, b.control_rate))
+      << a.control_rate << " vs " << b.control_rate;
+  EXPECT_TRUE(same_double(a.sample_interval, b.sample_interval))
+      << a.sample_interval << " vs " << b.sample_interval;
+  EXPECT_TRUE(same_double(a.design_theta, b.design_theta))
+      << a.design_theta << " vs " << b.design_theta;
   EXPECT_EQ(a.attempts, b.attempts);
   EXPECT_EQ(a.valid, b.valid);
   EXPECT_EQ(a.rejected, b.rejected);
@@ -273,7 +289,8 @@ const Bundle& straight_build(uint64_t edges, uint64_t seed) {
   const auto key = std::make_pair(edges, seed);
   const auto it = cache.find(key);
   if (it != cache.end()) return it->second;
-  const std::string dir = fresh_dir("straight-" + std::to_string(edges) + "-" + std::to_string(seed));
+  const std::string dir =
+      fresh_dir("straight-" + std::to_string(edges) + "-" + std::to_string(seed));
   const std::string out = dir + "/straight.h5";
   const CommandResult r = build_tool({"--out", out, "--edges", std::to_string(edges), "--seed",
                                       std::to_string(seed), "--threads", "2", "--quiet"});
@@ -288,9 +305,11 @@ const Bundle& straight_build(uint64_t edges, uint64_t seed) {
 TEST(BuildCli, SameBundleWhateverTheThreadCount) {
   const std::string dir = fresh_dir("threads");
   const std::string one = dir + "/one.h5", two = dir + "/two.h5", other = dir + "/other.h5";
-  const CommandResult r1 = build_tool({"--out", one, "--edges", "300", "--seed", "5", "--threads", "1", "--quiet"});
+  const CommandResult r1 =
+      build_tool({"--out", one, "--edges", "300", "--seed", "5", "--threads", "1", "--quiet"});
   ASSERT_EQ(r1.exit_code, 0) << describe(r1);
-  const CommandResult r2 = build_tool({"--out", two, "--edges", "300", "--seed", "5", "--threads", "2", "--quiet"});
+  const CommandResult r2 =
+      build_tool({"--out", two, "--edges", "300", "--seed", "5", "--threads", "2", "--quiet"});
   ASSERT_EQ(r2.exit_code, 0) << describe(r2);
   const Bundle a = read_bundle(one), b = read_bundle(two);
   EXPECT_TRUE(a.header.complete);
@@ -299,7 +318,8 @@ TEST(BuildCli, SameBundleWhateverTheThreadCount) {
   expect_same_bundle(a, b);
 
   // A different seed gives different edges.
-  const CommandResult r3 = build_tool({"--out", other, "--edges", "300", "--seed", "6", "--threads", "2", "--quiet"});
+  const CommandResult r3 =
+      build_tool({"--out", other, "--edges", "300", "--seed", "6", "--threads", "2", "--quiet"});
   ASSERT_EQ(r3.exit_code, 0) << describe(r3);
   const Bundle c = read_bundle(other);
   EXPECT_EQ(c.size(), 300u);
@@ -315,8 +335,17 @@ constexpr uint64_t kLongEdges = 2500;
 constexpr uint64_t kLongSeed = 3;
 
 std::vector<std::string> long_build_args(const std::string& out) {
-  return {"--out", out, "--edges", std::to_string(kLongEdges), "--seed", std::to_string(kLongSeed),
-          "--threads", "2", "--checkpoint-seconds", "0.2", "--quiet"};
+  return {"--out",
+          out,
+          "--edges",
+          std::to_string(kLongEdges),
+          "--seed",
+          std::to_string(kLongSeed),
+          "--threads",
+          "2",
+          "--checkpoint-seconds",
+          "0.2",
+          "--quiet"};
 }
 
 TEST(BuildCli, InterruptedBuildResumesToTheStraightBuild) {
@@ -351,7 +380,8 @@ TEST(BuildCli, InterruptedBuildResumesToTheStraightBuild) {
   const CommandResult inspect = build_tool({"--inspect", out});
   EXPECT_EQ(inspect.exit_code, 0) << describe(inspect);
   EXPECT_TRUE(contains(inspect.out, "INCOMPLETE")) << inspect.out;
-  EXPECT_TRUE(contains(inspect.out, "edges " + std::to_string(partial.size()) + " of " + std::to_string(kLongEdges)))
+  EXPECT_TRUE(contains(
+      inspect.out, "edges " + std::to_string(partial.size()) + " of " + std::to_string(kLongEdges)))
       << inspect.out;
 
   // The settings come from the file.
@@ -369,8 +399,10 @@ TEST(BuildCli, InterruptedBuildResumesToTheStraightBuild) {
 
 // After SIGKILL the file at --out is absent or a valid incomplete bundle that resumes to the
 // straight build; a temporary file of the killed process may remain (nothing else may).
-void check_killed_build(const std::string& dir, const std::string& out, pid_t killed_pid, bool must_exist) {
-  const std::string own_tmp = fs::path(out).filename().string() + ".tmp." + std::to_string(killed_pid);
+void check_killed_build(const std::string& dir, const std::string& out, pid_t killed_pid,
+                        bool must_exist) {
+  const std::string own_tmp =
+      fs::path(out).filename().string() + ".tmp." + std::to_string(killed_pid);
   auto unexpected_tmp = [&] {
     std::vector<std::string> bad;
     for (const std::string& f : tmp_files_in(dir)) {
@@ -380,7 +412,8 @@ void check_killed_build(const std::string& dir, const std::string& out, pid_t ki
   };
   EXPECT_TRUE(unexpected_tmp().empty()) << join(unexpected_tmp());
   if (!fs::exists(out)) {
-    EXPECT_FALSE(must_exist) << out << " vanished after SIGKILL although a checkpoint had been written";
+    EXPECT_FALSE(must_exist) << out
+                             << " vanished after SIGKILL although a checkpoint had been written";
     return;
   }
   const Bundle partial = read_bundle(out);  // throws (fails the test) if the kill broke it
@@ -430,7 +463,8 @@ TEST(BuildCli, KilledBuildLeavesNothingOrAResumableBundle) {
 TEST(BuildCli, ResumeRefusesOtherSettingsAndExtendsToTheStraightBuild) {
   const std::string dir = fresh_dir("resume");
   const std::string full = dir + "/full.h5", part = dir + "/part.h5";
-  const CommandResult r = build_tool({"--out", full, "--edges", "200", "--seed", "4", "--threads", "2", "--quiet"});
+  const CommandResult r =
+      build_tool({"--out", full, "--edges", "200", "--seed", "4", "--threads", "2", "--quiet"});
   ASSERT_EQ(r.exit_code, 0) << describe(r);
 
   // An interrupted build of 400 edges after 200: the same file with complete = 0.
@@ -465,7 +499,8 @@ TEST(BuildCli, ResumeRefusesOtherSettingsAndExtendsToTheStraightBuild) {
   }
 
   // A complete bundle resumed to its own size: nothing to do.
-  for (const std::vector<std::string>& extra : {std::vector<std::string>{"--edges", "200"}, std::vector<std::string>{}}) {
+  for (const std::vector<std::string>& extra :
+       {std::vector<std::string>{"--edges", "200"}, std::vector<std::string>{}}) {
     SCOPED_TRACE("complete bundle resumed with " + join(extra));
     const std::string before = read_file(full);
     std::vector<std::string> args = {"--resume", "--out", full};
@@ -487,7 +522,8 @@ TEST(BuildCli, ResumeRefusesOtherSettingsAndExtendsToTheStraightBuild) {
 
   // Extending a complete bundle, and finishing the interrupted one, give the straight build.
   const Bundle& straight = straight_build(400, 4);
-  const CommandResult extended = build_tool({"--resume", "--out", full, "--edges", "400", "--quiet"});
+  const CommandResult extended =
+      build_tool({"--resume", "--out", full, "--edges", "400", "--quiet"});
   ASSERT_EQ(extended.exit_code, 0) << describe(extended);
   {
     SCOPED_TRACE("complete 200 extended to 400");
@@ -521,7 +557,8 @@ TEST(BuildCli, ExistingOutputIsOnlyReplacedWithForce) {
   EXPECT_EQ(again.exit_code, 1);
   EXPECT_TRUE(read_file(out) == before) << "overwritten without --force";
 
-  const CommandResult forced = build_tool({"--out", out, "--edges", "60", "--seed", "2", "--quiet", "--force"});
+  const CommandResult forced =
+      build_tool({"--out", out, "--edges", "60", "--seed", "2", "--quiet", "--force"});
   ASSERT_EQ(forced.exit_code, 0) << describe(forced);
   EXPECT_FALSE(read_file(out) == before) << "--force did not replace the file";
   const Bundle b = read_bundle(out);
@@ -537,15 +574,18 @@ TEST(BuildCli, ExistingOutputIsOnlyReplacedWithForce) {
 
 struct BadCase {
   std::string name;
-  std::vector<std::string> args;      // "@OUT" stands for <case dir>/out.h5, "@DIR/x" for a file in it
+  std::vector<std::string> args;  // "@OUT" stands for <case dir>/out.h5, "@DIR/x" for a file in it
   std::vector<std::string> needles;   // "@OUT"/"@DIR" expanded likewise
   bool command_line_mistake = false;  // reported by CLI11: exit status >= 2; else exactly 1
   std::function<void(const std::string& dir)> setup;  // files placed in the case dir first
 
   BadCase(std::string name, std::vector<std::string> args, std::vector<std::string> needles,
           bool command_line_mistake = false, std::function<void(const std::string&)> setup = {})
-      : name(std::move(name)), args(std::move(args)), needles(std::move(needles)),
-        command_line_mistake(command_line_mistake), setup(std::move(setup)) {}
+      : name(std::move(name)),
+        args(std::move(args)),
+        needles(std::move(needles)),
+        command_line_mistake(command_line_mistake),
+        setup(std::move(setup)) {}
 };
 
 std::string expand(const std::string& s, const std::string& dir) {
@@ -609,9 +649,16 @@ TEST(BuildCli, BadInputIsOneLineAndWritesNothing) {
   const std::vector<BadCase> cases = {
       {"edges 0", {"--out", "@OUT", "--edges", "0"}, {"--edges", "> 0"}, true},
       {"seed -3", {"--out", "@OUT", "--seed", "-3"}, {"--seed", ">= 0"}, true},
-      {"checkpoint -1", {"--out", "@OUT", "--checkpoint-seconds", "-1"}, {"--checkpoint-seconds"}, true},
-      {"durations reversed", {"--out", "@OUT", "--min-duration", "0.8", "--max-duration", "0.5"}, {"--max-duration"}},
-      {"region outside the limits", {"--out", "@OUT", "--region", outside}, {"--region", "joint 1", "2.897"}},
+      {"checkpoint -1",
+       {"--out", "@OUT", "--checkpoint-seconds", "-1"},
+       {"--checkpoint-seconds"},
+       true},
+      {"durations reversed",
+       {"--out", "@OUT", "--min-duration", "0.8", "--max-duration", "0.5"},
+       {"--max-duration"}},
+      {"region outside the limits",
+       {"--out", "@OUT", "--region", outside},
+       {"--region", "joint 1", "2.897"}},
       {"region with 2 pairs", {"--out", "@OUT", "--region", "-1:1,-0.3:0.7"}, {"--region", "7"}},
       {"region with 8 pairs",
        {"--out", "@OUT", "--region", "-1:1,-0.3:0.7,-0.6:0.6,-2.6:-1.4,-0.6:0.6,1.3:2.5,0:1.6,0:1"},
@@ -665,8 +712,9 @@ TEST(BuildCli, BadInputIsOneLineAndWritesNothing) {
 // An unsigned option must not wrap a negative number around to 2^64 - 1 (and then build
 // forever): the watchdog ends such a run after a few seconds, which fails the test.
 TEST(BuildCli, NegativeEdgesIsRefused) {
-  expect_bad_input({"edges negative", {"--out", "@OUT", "--edges", "-1", "--quiet"}, {"--edges"}, true},
-                   "bad-negative-edges");
+  expect_bad_input(
+      {"edges negative", {"--out", "@OUT", "--edges", "-1", "--quiet"}, {"--edges"}, true},
+      "bad-negative-edges");
 }
 
 TEST(BuildCli, RegionFromAJsonFile) {
@@ -675,7 +723,8 @@ TEST(BuildCli, RegionFromAJsonFile) {
   write_bytes(region, R"({"description": "a smaller box",
                           "lower": [-0.5, -0.2, -0.4, -2.4, -0.4, 1.5, 0.2],
                           "upper": [0.5, 0.6, 0.4, -1.6, 0.4, 2.3, 1.4]})");
-  const CommandResult r = build_tool({"--out", out, "--edges", "40", "--region", region, "--quiet"});
+  const CommandResult r =
+      build_tool({"--out", out, "--edges", "40", "--region", region, "--quiet"});
   ASSERT_EQ(r.exit_code, 0) << describe(r);
   const Bundle b = read_bundle(out);
   EXPECT_EQ(b.header.region_lower, (std::vector<double>{-0.5, -0.2, -0.4, -2.4, -0.4, 1.5, 0.2}));
@@ -821,11 +870,14 @@ TEST(BuildCli, FreshBundleFollowsTheSchema) {
     const uint64_t expected_samples = ticks / every + 1 + (ticks % every != 0);
     EXPECT_EQ(s1 - s0, expected_samples) << "duration " << b.duration[e];
     for (int i = 0; i < n; ++i) {
-      EXPECT_EQ(b.sample_q[s0 * n + i], static_cast<float>(b.q0[e * n + i])) << "first sample, joint " << i + 1;
+      EXPECT_EQ(b.sample_q[s0 * n + i], static_cast<float>(b.q0[e * n + i]))
+          << "first sample, joint " << i + 1;
       EXPECT_EQ(b.sample_dq[s0 * n + i], 0.0f) << "first sample velocity, joint " << i + 1;
-      EXPECT_EQ(b.sample_q[(s1 - 1) * n + i], static_cast<float>(b.qf[e * n + i])) << "last sample, joint " << i + 1;
+      EXPECT_EQ(b.sample_q[(s1 - 1) * n + i], static_cast<float>(b.qf[e * n + i]))
+          << "last sample, joint " << i + 1;
       // At rest: below the simulator's settle velocity (1e-3 rad/s).
-      EXPECT_LE(std::abs(b.sample_dq[(s1 - 1) * n + i]), 1e-3f) << "last sample velocity, joint " << i + 1;
+      EXPECT_LE(std::abs(b.sample_dq[(s1 - 1) * n + i]), 1e-3f)
+          << "last sample velocity, joint " << i + 1;
     }
   }
 
@@ -845,11 +897,14 @@ TEST(BuildCli, FreshBundleFollowsTheSchema) {
 TEST(BuildCli, ProgressIsPlainLinesWithASummary) {
   const std::string dir = fresh_dir("progress");
   const std::string out = dir + "/b.h5";
-  const CommandResult r = build_tool({"--out", out, "--edges", "300", "--seed", "5", "--threads", "2"});
+  const CommandResult r =
+      build_tool({"--out", out, "--edges", "300", "--seed", "5", "--threads", "2"});
   ASSERT_EQ(r.exit_code, 0) << describe(r);
   EXPECT_EQ(r.out, "");
-  EXPECT_FALSE(contains(r.err, "\r")) << "carriage return on stderr that is not a terminal:\n" << r.err;
-  EXPECT_FALSE(contains(r.err, "\x1b")) << "escape sequence on stderr that is not a terminal:\n" << r.err;
+  EXPECT_FALSE(contains(r.err, "\r")) << "carriage return on stderr that is not a terminal:\n"
+                                      << r.err;
+  EXPECT_FALSE(contains(r.err, "\x1b")) << "escape sequence on stderr that is not a terminal:\n"
+                                        << r.err;
   ASSERT_FALSE(r.err.empty());
   EXPECT_EQ(r.err.back(), '\n');
   EXPECT_TRUE(contains(r.err, "300/300")) << r.err;
@@ -857,9 +912,11 @@ TEST(BuildCli, ProgressIsPlainLinesWithASummary) {
   const Bundle b = read_bundle(out);
   const BundleHeader& h = b.header;
   EXPECT_TRUE(contains(r.err, "300 edges (complete)")) << r.err;
-  EXPECT_TRUE(contains(r.err, "attempts " + std::to_string(h.attempts) + ", valid " + std::to_string(h.valid)))
+  EXPECT_TRUE(contains(
+      r.err, "attempts " + std::to_string(h.attempts) + ", valid " + std::to_string(h.valid)))
       << r.err;
-  ASSERT_FALSE(h.rejected.empty()) << "test setup: no rejection in this build, the summary check means nothing";
+  ASSERT_FALSE(h.rejected.empty())
+      << "test setup: no rejection in this build, the summary check means nothing";
   std::istringstream lines(r.err);
   std::string line;
   std::map<std::string, std::string> reported;  // reason -> count as printed

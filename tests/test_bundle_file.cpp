@@ -1,11 +1,10 @@
 // The edge bundle's HDF5 file: round trips, contiguous storage for memory-mapping, crash-safe
 // rewrites and one-line errors for every kind of bad file.
 #include <fcntl.h>
+#include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
-
-#include <gtest/gtest.h>
 
 #include <chrono>
 #include <cstring>
@@ -58,7 +57,8 @@ Bundle random_bundle(size_t n, int dof, uint64_t seed) {
   h.design_theta = 0.3;
   h.attempts = 123456789012ull;
   h.valid = n;
-  h.rejected = {{"collision", 17}, {"joint_limit", 4}, {"torque_limit", 0}, {"unstable settle", 99}};
+  h.rejected = {
+      {"collision", 17}, {"joint_limit", 4}, {"torque_limit", 0}, {"unstable settle", 99}};
   h.start_resamples = 77;
   h.integrator = "rk4";
   h.substeps = 3;
@@ -100,7 +100,8 @@ Bundle empty_bundle(int dof) {
 
 template <class T>
 bool same_bytes(const std::vector<T>& a, const std::vector<T>& b) {
-  return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
+  return a.size() == b.size() &&
+         (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
 }
 
 bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
@@ -314,7 +315,8 @@ TEST(BundleFile, FailedWriteKeepsTheOldFile) {
   // A failure after the temporary file is under way: something is in the way of its name.
   const std::string tmp = path + ".tmp." + std::to_string(::getpid());
   fs::create_directory(tmp);
-  expect_error(error_of([&] { write_bundle(path, random_bundle(40, 7, 4)); }), tmp, {"cannot create"});
+  expect_error(error_of([&] { write_bundle(path, random_bundle(40, 7, 4)); }), tmp,
+               {"cannot create"});
   expect_same(old, read_bundle(path));
   EXPECT_TRUE(fs::is_directory(tmp));  // not ours to remove
   fs::remove(tmp);
@@ -337,7 +339,8 @@ TEST(BundleFile, InconsistentBundlesAreRefusedNamingTheField) {
       {[](Bundle& b) { b.attempt.clear(); }, {"bundle.attempt"}},
       {[](Bundle& b) { b.knot_offset.pop_back(); }, {"bundle.knot_offset", "edges + 1"}},
       {[](Bundle& b) { b.sample_offset[0] = 1; }, {"bundle.sample_offset", "first value"}},
-      {[](Bundle& b) { b.knot_offset.back() += 1; }, {"bundle.knot_offset", "last value", "bundle.knots"}},
+      {[](Bundle& b) { b.knot_offset.back() += 1; },
+       {"bundle.knot_offset", "last value", "bundle.knots"}},
       {[](Bundle& b) { std::swap(b.sample_offset[3], b.sample_offset[4]); },
        {"bundle.sample_offset", "decreases at edge 3"}},
       {[](Bundle& b) { b.knots.pop_back(); }, {"bundle.knots", "multiple of dof"}},
@@ -348,7 +351,8 @@ TEST(BundleFile, InconsistentBundlesAreRefusedNamingTheField) {
     c.spoil(b);
     const std::string message = error_of([&] { write_bundle(path, b); });
     expect_error(message, path, {});
-    for (const std::string& part : c.parts) EXPECT_NE(message.find(part), std::string::npos) << message;
+    for (const std::string& part : c.parts)
+      EXPECT_NE(message.find(part), std::string::npos) << message;
     EXPECT_FALSE(fs::exists(path));
     EXPECT_TRUE(others_in_dir(path).empty());
   }
@@ -417,13 +421,15 @@ TEST(BundleFile, OtherSchemaVersions) {
       h5::File file(H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT));
       ASSERT_TRUE(file.valid());
       h5::Dataspace space(H5Screate(H5S_SCALAR));
-      h5::Attribute attr(H5Acreate2(file, "schema_version", H5T_STD_I32LE, space, H5P_DEFAULT, H5P_DEFAULT));
+      h5::Attribute attr(
+          H5Acreate2(file, "schema_version", H5T_STD_I32LE, space, H5P_DEFAULT, H5P_DEFAULT));
       ASSERT_TRUE(attr.valid());
       ASSERT_GE(H5Awrite(attr, H5T_NATIVE_INT, &version), 0);
     }
     const std::string message = error_of([&] { read_bundle(path); });
-    expect_error(message, path, {"schema_version " + std::to_string(version),
-                                 version > 1 ? "newer lazyboe" : "older lazyboe"});
+    expect_error(message, path,
+                 {"schema_version " + std::to_string(version),
+                  version > 1 ? "newer lazyboe" : "older lazyboe"});
     EXPECT_EQ(error_of([&] { read_bundle_header(path); }), message);
   }
 }
@@ -461,14 +467,17 @@ std::string damaged(const std::string& name, const std::function<void(hid_t)>& d
 }
 
 TEST(BundleFile, MissingDataset) {
-  const std::string path = damaged("noqf", [](hid_t f) { ASSERT_GE(H5Ldelete(f, "/edges/qf", H5P_DEFAULT), 0); });
+  const std::string path =
+      damaged("noqf", [](hid_t f) { ASSERT_GE(H5Ldelete(f, "/edges/qf", H5P_DEFAULT), 0); });
   expect_error(error_of([&] { read_bundle(path); }), path, {"/edges/qf", "missing"});
   read_bundle_header(path);  // the header alone is still fine
 }
 
 TEST(BundleFile, MissingAttribute) {
-  const std::string path = damaged("noattr", [](hid_t f) { ASSERT_GE(H5Adelete(f, "design_theta"), 0); });
-  expect_error(error_of([&] { read_bundle_header(path); }), path, {"attribute design_theta missing"});
+  const std::string path =
+      damaged("noattr", [](hid_t f) { ASSERT_GE(H5Adelete(f, "design_theta"), 0); });
+  expect_error(error_of([&] { read_bundle_header(path); }), path,
+               {"attribute design_theta missing"});
 }
 
 TEST(BundleFile, WrongShape) {
@@ -476,7 +485,8 @@ TEST(BundleFile, WrongShape) {
     ASSERT_GE(H5Ldelete(f, "/edges/q0", H5P_DEFAULT), 0);
     h5::write_dataset<double>("x", f, "/edges/q0", std::vector<double>(50 * 6), {50, 6});
   });
-  expect_error(error_of([&] { read_bundle(path); }), path, {"/edges/q0", "shape 50 x 6, expected 50 x 7"});
+  expect_error(error_of([&] { read_bundle(path); }), path,
+               {"/edges/q0", "shape 50 x 6, expected 50 x 7"});
 }
 
 TEST(BundleFile, WrongType) {
@@ -484,7 +494,8 @@ TEST(BundleFile, WrongType) {
     ASSERT_GE(H5Ldelete(f, "/edges/duration", H5P_DEFAULT), 0);
     h5::write_dataset<float>("x", f, "/edges/duration", std::vector<float>(50), {50});
   });
-  expect_error(error_of([&] { read_bundle(path); }), path, {"/edges/duration", "float32", "float64"});
+  expect_error(error_of([&] { read_bundle(path); }), path,
+               {"/edges/duration", "float32", "float64"});
 }
 
 void set_last_offset(hid_t f, const char* name, uint64_t delta, bool decrease_middle = false) {
@@ -496,7 +507,8 @@ void set_last_offset(hid_t f, const char* name, uint64_t delta, bool decrease_mi
 }
 
 TEST(BundleFile, KnotOffsetDisagreesWithKnots) {
-  const std::string path = damaged("knots", [](hid_t f) { set_last_offset(f, "/edges/knot_offset", 1); });
+  const std::string path =
+      damaged("knots", [](hid_t f) { set_last_offset(f, "/edges/knot_offset", 1); });
   expect_error(error_of([&] { read_bundle(path); }), path,
                {"/edges/knot_offset", "last value", "/controls/knots"});
 }
@@ -504,14 +516,16 @@ TEST(BundleFile, KnotOffsetDisagreesWithKnots) {
 TEST(BundleFile, SampleOffsetDecreases) {
   const std::string path =
       damaged("samples", [](hid_t f) { set_last_offset(f, "/edges/sample_offset", 0, true); });
-  expect_error(error_of([&] { read_bundle(path); }), path, {"/edges/sample_offset", "decreases at edge 10"});
+  expect_error(error_of([&] { read_bundle(path); }), path,
+               {"/edges/sample_offset", "decreases at edge 10"});
 }
 
 TEST(BundleFile, RejectedAttributesMustPair) {
   const std::string path = damaged("rejected", [](hid_t f) {
     h5::write_attr_u64s("x", f, "rejected_counts", {1, 2});
   });
-  expect_error(error_of([&] { read_bundle_header(path); }), path, {"rejected_counts", "rejected_reasons"});
+  expect_error(error_of([&] { read_bundle_header(path); }), path,
+               {"rejected_counts", "rejected_reasons"});
 }
 
 }  // namespace

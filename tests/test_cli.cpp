@@ -44,7 +44,8 @@ CommandResult robot_tool(const std::vector<std::string>& args) {
 std::string table_env() { return source_path("data/environments/table.json"); }
 
 std::string describe(const CommandResult& r) {
-  return "exit " + std::to_string(r.exit_code) + "\n--- stdout:\n" + r.out + "--- stderr:\n" + r.err;
+  return "exit " + std::to_string(r.exit_code) + "\n--- stdout:\n" + r.out + "--- stderr:\n" +
+         r.err;
 }
 
 long count_lines(const std::string& s) { return std::count(s.begin(), s.end(), '\n'); }
@@ -54,9 +55,11 @@ long count_lines(const std::string& s) { return std::count(s.begin(), s.end(), '
 void expect_one_line_error(const CommandResult& r, const std::vector<std::string>& needles) {
   std::string problems;
   if (r.exit_code == 0) problems += "  exit status 0 (expected failure)\n";
-  if (r.exit_code < 0 || r.exit_code >= 128) problems += "  exit status looks like a signal or crash\n";
+  if (r.exit_code < 0 || r.exit_code >= 128)
+    problems += "  exit status looks like a signal or crash\n";
   if (count_lines(r.err) != 1 || r.err.empty() || r.err.back() != '\n') {
-    problems += "  expected exactly one line on stderr, got " + std::to_string(count_lines(r.err)) + "\n";
+    problems +=
+        "  expected exactly one line on stderr, got " + std::to_string(count_lines(r.err)) + "\n";
   }
   if (!r.out.empty()) problems += "  stdout is not empty\n";
   for (const std::string& n : needles) {
@@ -215,7 +218,8 @@ TEST(Cli, InfoJsonParsesWithSevenDof) {
   }
   ASSERT_EQ(j.at("collision_bodies").size(), panda().collision_bodies.size());
   for (size_t i = 0; i < panda().collision_bodies.size(); ++i) {
-    EXPECT_EQ(j["collision_bodies"][i].at("name").get<std::string>(), panda().collision_bodies[i].name);
+    EXPECT_EQ(j["collision_bodies"][i].at("name").get<std::string>(),
+              panda().collision_bodies[i].name);
   }
   EXPECT_DOUBLE_EQ(j["joints"][3].at("lower").get<double>(), -3.0718);
   EXPECT_DOUBLE_EQ(j["joints"][3].at("upper").get<double>(), -0.0698);
@@ -234,8 +238,9 @@ TEST(Cli, FkAtZeroIsTheFlangePose) {
   EXPECT_NEAR(p[2], 0.926, 1e-9);
   const std::vector<double> quat = j.at("quaternion").get<std::vector<double>>();
   ASSERT_EQ(quat.size(), 4u);
-  EXPECT_NEAR(std::sqrt(quat[0] * quat[0] + quat[1] * quat[1] + quat[2] * quat[2] + quat[3] * quat[3]),
-              1.0, 1e-12);
+  EXPECT_NEAR(
+      std::sqrt(quat[0] * quat[0] + quat[1] * quat[1] + quat[2] * quat[2] + quat[3] * quat[3]), 1.0,
+      1e-12);
 }
 
 TEST(Cli, FkOfNamedLinkMatchesLibrary) {
@@ -422,13 +427,15 @@ TEST(Cli, RobotConfigInvalidJsonNamesLine) {
 
 TEST(Cli, RobotConfigMissingJoints) {
   const std::string config = robot_with_config("cfg_nojoints", [](json& j) { j.erase("joints"); });
-  expect_one_line_error(robot_tool({"--robot", config, "info"}), {"cfg_nojoints/panda.json", "joints"});
+  expect_one_line_error(robot_tool({"--robot", config, "info"}),
+                        {"cfg_nojoints/panda.json", "joints"});
 }
 
 TEST(Cli, RobotConfigWrongType) {
   const std::string config =
       robot_with_config("cfg_type", [](json& j) { j["control_rate"] = "fast"; });
-  expect_one_line_error(robot_tool({"--robot", config, "info"}), {"cfg_type/panda.json", "control_rate"});
+  expect_one_line_error(robot_tool({"--robot", config, "info"}),
+                        {"cfg_type/panda.json", "control_rate"});
   const std::string config2 =
       robot_with_config("cfg_type2", [](json& j) { j["collision"]["margin"] = "big"; });
   expect_one_line_error(robot_tool({"--robot", config2, "info"}),
@@ -451,7 +458,8 @@ TEST(Cli, RobotConfigUnknownFrictionModel) {
 
 TEST(Cli, RobotConfigUnknownTopLevelField) {
   const std::string config = robot_with_config("cfg_extra", [](json& j) { j["colour"] = "red"; });
-  expect_one_line_error(robot_tool({"--robot", config, "info"}), {"cfg_extra/panda.json", "colour"});
+  expect_one_line_error(robot_tool({"--robot", config, "info"}),
+                        {"cfg_extra/panda.json", "colour"});
 }
 
 TEST(Cli, RobotConfigAllowedPairUnknownLink) {
@@ -460,9 +468,10 @@ TEST(Cli, RobotConfigAllowedPairUnknownLink) {
     index = j["collision"]["allowed_pairs"].size();
     j["collision"]["allowed_pairs"].push_back({"panda_link3", "panda_hand"});
   });
-  expect_one_line_error(robot_tool({"--robot", config, "info"}),
-                        {"cfg_pair/panda.json",
-                         "collision.allowed_pairs[" + std::to_string(index) + "][1]", "panda_hand"});
+  expect_one_line_error(
+      robot_tool({"--robot", config, "info"}),
+      {"cfg_pair/panda.json", "collision.allowed_pairs[" + std::to_string(index) + "][1]",
+       "panda_hand"});
 }
 
 TEST(Cli, RobotConfigMissingUrdf) {
@@ -487,12 +496,13 @@ TEST(Cli, UrdfMalformedXmlNamesLine) {
   const size_t at = text.find("</link>");
   ASSERT_NE(at, std::string::npos);
   const int line = 1 + static_cast<int>(std::count(text.begin(), text.begin() + at, '\n'));
-  const std::string config = robot_with_urdf("urdf_xml_line", replace_once(text, "</link>", "</lnk>"));
+  const std::string config =
+      robot_with_urdf("urdf_xml_line", replace_once(text, "</link>", "</lnk>"));
   const CommandResult r = robot_tool({"--robot", config, "info"});
   expect_one_line_error(r, {"urdf_xml_line/panda.urdf"});
   const std::regex names_line("(:|line )" + std::to_string(line) + "\\b");
-  EXPECT_TRUE(std::regex_search(r.err, names_line))
-      << "message does not name line " << line << "\n" << describe(r);
+  EXPECT_TRUE(std::regex_search(r.err, names_line)) << "message does not name line " << line << "\n"
+                                                    << describe(r);
 }
 
 TEST(Cli, UrdfNegativeMass) {
@@ -504,11 +514,11 @@ TEST(Cli, UrdfNegativeMass) {
 }
 
 TEST(Cli, UrdfNonPhysicalInertia) {
-  const std::string urdf = replace_once(
-      panda_urdf_text(),
-      "ixx=\"2.5853e-02\" ixy=\"7.7960e-03\" ixz=\"-1.3320e-03\" iyy=\"1.9552e-02\" "
-      "iyz=\"8.6410e-03\" izz=\"2.8323e-02\"",
-      "ixx=\"1\" ixy=\"0\" ixz=\"0\" iyy=\"1\" iyz=\"0\" izz=\"5\"");
+  const std::string urdf =
+      replace_once(panda_urdf_text(),
+                   "ixx=\"2.5853e-02\" ixy=\"7.7960e-03\" ixz=\"-1.3320e-03\" iyy=\"1.9552e-02\" "
+                   "iyz=\"8.6410e-03\" izz=\"2.8323e-02\"",
+                   "ixx=\"1\" ixy=\"0\" ixz=\"0\" iyy=\"1\" iyz=\"0\" izz=\"5\"");
   const std::string config = robot_with_urdf("urdf_inertia", urdf);
   expect_one_line_error(robot_tool({"--robot", config, "info"}),
                         {"urdf_inertia/panda.urdf", "panda_link4", "inertia"});
@@ -582,8 +592,8 @@ TEST(Cli, TorquesMissingInput) {
 }
 
 TEST(Cli, TorquesWrongHeader) {
-  const std::string in = write_temp_file("torques_bad/header.csv",
-                                         "q1,q2,q3,q4,q5,q6,q7\n0,0,0,-1,0,1,0\n");
+  const std::string in =
+      write_temp_file("torques_bad/header.csv", "q1,q2,q3,q4,q5,q6,q7\n0,0,0,-1,0,1,0\n");
   expect_one_line_error(robot_tool({"torques", "--in", in, "--out", torques_out()}),
                         {in + ":1:", "header"});
 }
@@ -626,7 +636,8 @@ TEST(Cli, TorquesUnwritableOutput) {
 // ------------------------------------------------------------------------------------------
 
 std::string check_input() {
-  return write_temp_file("check_bad/in.csv", "q1,q2,q3,q4,q5,q6,q7\n0,-0.785,0,-2.356,0,1.571,0.785\n");
+  return write_temp_file("check_bad/in.csv",
+                         "q1,q2,q3,q4,q5,q6,q7\n0,-0.785,0,-2.356,0,1.571,0.785\n");
 }
 std::string check_out() { return temp_dir() + "/check_bad/out.csv"; }
 
@@ -658,27 +669,31 @@ TEST(Cli, CheckEnvironmentAllowedLinkUnknown) {
   expect_one_line_error(r, {env, "panda_hand"});
   EXPECT_TRUE(r.err.find("floor") != std::string::npos ||
               r.err.find("objects[0]") != std::string::npos)
-      << "message does not say which object\n" << describe(r);
+      << "message does not say which object\n"
+      << describe(r);
 }
 
 TEST(Cli, CheckEnvironmentNegativeBoxSize) {
-  const std::string env =
-      env_with("size.json", [](json& j) { j["objects"][1]["size"] = {0.6, -1.2, 0.04}; });
+  const std::string env = env_with("size.json", [](json& j) {
+    j["objects"][1]["size"] = {0.6, -1.2, 0.04};
+  });
   expect_one_line_error(
       robot_tool({"check", "--env", env, "--in", check_input(), "--out", check_out()}),
       {env, "objects[1].size"});
 }
 
 TEST(Cli, CheckEnvironmentRpyAndQuaternion) {
-  const std::string env =
-      env_with("rot.json", [](json& j) { j["objects"][1]["quaternion"] = {1, 0, 0, 0}; });
+  const std::string env = env_with("rot.json", [](json& j) {
+    j["objects"][1]["quaternion"] = {1, 0, 0, 0};
+  });
   expect_one_line_error(
       robot_tool({"check", "--env", env, "--in", check_input(), "--out", check_out()}),
       {env, "objects[1]", "rpy", "quaternion"});
 }
 
 TEST(Cli, CheckWrongCsvHeader) {
-  const std::string in = write_temp_file("check_bad/header.csv", "j1,j2,j3,j4,j5,j6,j7\n0,0,0,-1,0,1,0\n");
+  const std::string in =
+      write_temp_file("check_bad/header.csv", "j1,j2,j3,j4,j5,j6,j7\n0,0,0,-1,0,1,0\n");
   expect_one_line_error(
       robot_tool({"check", "--env", table_env(), "--in", in, "--out", check_out()}),
       {in + ":1:", "header"});
@@ -712,9 +727,9 @@ TEST(Cli, TorquesErrorKeepsExistingOutput) {
 
 TEST(Cli, CheckErrorKeepsExistingOutput) {
   const std::string dir = temp_dir() + "/keep_check";
-  const std::string in = write_temp_file(
-      "keep_check/in.csv",
-      "q1,q2,q3,q4,q5,q6,q7\n0,0,0,-1,0,1,0\n0,0,0,-1,0,inf,0\n0,0,0,-1,0,1,0\n");
+  const std::string in =
+      write_temp_file("keep_check/in.csv",
+                      "q1,q2,q3,q4,q5,q6,q7\n0,0,0,-1,0,1,0\n0,0,0,-1,0,inf,0\n0,0,0,-1,0,1,0\n");
   const std::string out = write_temp_file("keep_check/out.csv", "previous results\n");
   const std::vector<std::string> before = files_in(dir);
   const CommandResult r = robot_tool({"check", "--env", table_env(), "--in", in, "--out", out});
@@ -723,8 +738,10 @@ TEST(Cli, CheckErrorKeepsExistingOutput) {
   EXPECT_EQ(files_in(dir), before) << "a temporary file was left behind";
 
   // Also when the environment is the bad part.
-  const std::string env = write_temp_file("keep_check/env.json", "{\"schema_version\": 1,\n  oops\n}\n");
-  const std::string good_in = write_temp_file("keep_check/good.csv", "q1,q2,q3,q4,q5,q6,q7\n0,0,0,-1,0,1,0\n");
+  const std::string env =
+      write_temp_file("keep_check/env.json", "{\"schema_version\": 1,\n  oops\n}\n");
+  const std::string good_in =
+      write_temp_file("keep_check/good.csv", "q1,q2,q3,q4,q5,q6,q7\n0,0,0,-1,0,1,0\n");
   const CommandResult r2 = robot_tool({"check", "--env", env, "--in", good_in, "--out", out});
   expect_one_line_error(r2, {env + ":2:"});
   EXPECT_EQ(read_file(out), "previous results\n");

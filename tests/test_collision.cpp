@@ -92,7 +92,8 @@ TEST(Collision, AdjacentLinksOverlapButAreExcluded) {
   // Neighbouring capsules overlap at their joints by design, in every configuration.
   EXPECT_FALSE(normal.report(kReady).self_collision);
   EXPECT_TRUE(unfiltered.report(kReady).self_collision);
-  const int l1 = shape_index(unfiltered.model, "link1_a"), l2 = shape_index(unfiltered.model, "link2_a");
+  const int l1 = shape_index(unfiltered.model, "link1_a"),
+            l2 = shape_index(unfiltered.model, "link2_a");
   ASSERT_GE(l1, 0);
   ASSERT_GE(l2, 0);
   EXPECT_TRUE(self_pair_collides(unfiltered.model, unfiltered.cd, l1, l2));
@@ -152,7 +153,8 @@ TEST(Collision, FastCheckAgreesWithExactDistances) {
     int colliding = 0, free = 0, checked = 0;
     for (int trial = 0; trial < 3000; ++trial) {
       JointVector q(robot.dof);
-      for (int i = 0; i < robot.dof; ++i) q[i] = robot.q_min[i] + u(rng) * (robot.q_max[i] - robot.q_min[i]);
+      for (int i = 0; i < robot.dof; ++i)
+        q[i] = robot.q_min[i] + u(rng) * (robot.q_max[i] - robot.q_min[i]);
       c.set(q);
       const DistanceReport d = min_distance(c.model, c.cd);
       if (std::abs(d.min() - c.model.margin) < 1e-6) continue;  // too close to call
@@ -199,7 +201,8 @@ TEST(Collision, DerivedAllowedPairsAreAdjacentLinks) {
       EXPECT_EQ(p.collisions, result.samples);  // the capsules overlap at every joint
       ++adjacent;
     } else {
-      EXPECT_TRUE(p.reason.empty()) << robot.links[p.link_a].name << "-" << robot.links[p.link_b].name;
+      EXPECT_TRUE(p.reason.empty())
+          << robot.links[p.link_a].name << "-" << robot.links[p.link_b].name;
       EXPECT_LT(p.collisions, result.samples);
     }
   }

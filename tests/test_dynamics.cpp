@@ -10,10 +10,9 @@
 #include <new>
 #include <random>
 
-#include "robot/dynamics.h"
 #include "alloc_counter.h"
+#include "robot/dynamics.h"
 #include "test_util.h"
-
 
 namespace lazyboe {
 namespace {
@@ -59,7 +58,8 @@ JointMatrix mass_matrix_from_jacobians(const RobotModel& robot, const JointVecto
         Jv.col(j) = axis;
       }
     }
-    const Eigen::Matrix3d I_world = data.body_pose[i].R * b.inertia_com * data.body_pose[i].R.transpose();
+    const Eigen::Matrix3d I_world =
+        data.body_pose[i].R * b.inertia_com * data.body_pose[i].R.transpose();
     M += b.mass * Jv.transpose() * Jv + Jw.transpose() * I_world * Jw;
   }
   return M;
@@ -135,7 +135,8 @@ TEST(Dynamics, GravityIsGradientOfPotentialEnergy) {
       JointVector qp = s.q, qm = s.q;
       qp[k] += eps;
       qm[k] -= eps;
-      const double dV = (potential_energy(robot, data, qp) - potential_energy(robot, data, qm)) / (2 * eps);
+      const double dV =
+          (potential_energy(robot, data, qp) - potential_energy(robot, data, qm)) / (2 * eps);
       EXPECT_NEAR(g[k], dV, 1e-6 * std::max(1.0, std::abs(dV)));
     }
   }
@@ -300,7 +301,8 @@ TEST(Dynamics, SharedTermsMatchSeparateAlgorithms) {
   for (int trial = 0; trial < 100; ++trial) {
     const State s = random_state(robot, rng);
     JointVector tau(7);
-    for (int i = 0; i < 7; ++i) tau[i] = std::uniform_real_distribution<double>(-1, 1)(rng) * robot.tau_max[i];
+    for (int i = 0; i < 7; ++i)
+      tau[i] = std::uniform_real_distribution<double>(-1, 1)(rng) * robot.tau_max[i];
     dynamics_terms(robot, shared, s.q, s.dq);
     const JointVector g = gravity_torques(robot, separate, s.q);
     EXPECT_LT((shared.gravity - g).norm(), 1e-12 * std::max(1.0, g.norm()));

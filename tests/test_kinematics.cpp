@@ -14,18 +14,17 @@ namespace {
 JointVector random_q(const RobotModel& robot, std::mt19937_64& rng) {
   std::uniform_real_distribution<double> u(0, 1);
   JointVector q(robot.dof);
-  for (int i = 0; i < robot.dof; ++i) q[i] = robot.q_min[i] + u(rng) * (robot.q_max[i] - robot.q_min[i]);
+  for (int i = 0; i < robot.dof; ++i)
+    q[i] = robot.q_min[i] + u(rng) * (robot.q_max[i] - robot.q_min[i]);
   return q;
 }
 
 // Modified DH: T = RotX(alpha) TransX(a) RotZ(theta) TransZ(d).
 Eigen::Matrix4d mdh(double a, double d, double alpha, double theta) {
-  const double ca = std::cos(alpha), sa = std::sin(alpha), ct = std::cos(theta), st = std::sin(theta);
+  const double ca = std::cos(alpha), sa = std::sin(alpha), ct = std::cos(theta),
+               st = std::sin(theta);
   Eigen::Matrix4d T;
-  T << ct, -st, 0, a,
-       st * ca, ct * ca, -sa, -d * sa,
-       st * sa, ct * sa, ca, d * ca,
-       0, 0, 0, 1;
+  T << ct, -st, 0, a, st * ca, ct * ca, -sa, -d * sa, st * sa, ct * sa, ca, d * ca, 0, 0, 0, 1;
   return T;
 }
 

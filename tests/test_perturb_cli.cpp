@@ -13,14 +13,13 @@
 // built once per test binary and copied, and each uninterrupted reference analysis is run once
 // and cached.
 #include <fcntl.h>
+#include <gtest/gtest.h>
+#include <hdf5.h>
 #include <signal.h>
 #include <spawn.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
-
-#include <gtest/gtest.h>
-#include <hdf5.h>
 
 #include <algorithm>
 #include <cerrno>
@@ -63,8 +62,10 @@ std::string quote(const std::string& s) {
 
 // The shell command line of a tool with the given arguments (each shell-quoted), under a
 // watchdog that kills a run that does not end (a hang fails the test instead of stalling it).
-std::string tool_command(const std::string& tool, const std::vector<std::string>& args, double timeout_seconds) {
-  std::string cmd = "timeout -s KILL " + std::to_string(timeout_seconds) + " " + quote(tool_path(tool));
+std::string tool_command(const std::string& tool, const std::vector<std::string>& args,
+                         double timeout_seconds) {
+  std::string cmd =
+      "timeout -s KILL " + std::to_string(timeout_seconds) + " " + quote(tool_path(tool));
   for (const std::string& a : args) cmd += " " + quote(a);
   return cmd;
 }
@@ -84,7 +85,8 @@ CommandResult build_tool(const std::vector<std::string>& args, double timeout_se
 }
 
 std::string describe(const CommandResult& r) {
-  return "exit " + std::to_string(r.exit_code) + "\n--- stdout:\n" + r.out + "--- stderr:\n" + r.err;
+  return "exit " + std::to_string(r.exit_code) + "\n--- stdout:\n" + r.out + "--- stderr:\n" +
+         r.err;
 }
 
 long count_lines(const std::string& s) { return std::count(s.begin(), s.end(), '\n'); }
@@ -104,9 +106,11 @@ std::string join(const std::vector<std::string>& v) {
 void expect_one_line_error(const CommandResult& r, const std::vector<std::string>& needles) {
   std::string problems;
   if (r.exit_code == 0) problems += "  exit status 0 (expected failure)\n";
-  if (r.exit_code < 0 || r.exit_code >= 124) problems += "  exit status looks like a signal, crash or timeout\n";
+  if (r.exit_code < 0 || r.exit_code >= 124)
+    problems += "  exit status looks like a signal, crash or timeout\n";
   if (count_lines(r.err) != 1 || r.err.empty() || r.err.back() != '\n') {
-    problems += "  expected exactly one line on stderr, got " + std::to_string(count_lines(r.err)) + "\n";
+    problems +=
+        "  expected exactly one line on stderr, got " + std::to_string(count_lines(r.err)) + "\n";
   }
   if (!r.out.empty()) problems += "  stdout is not empty\n";
   for (const std::string& n : needles) {
@@ -186,8 +190,10 @@ Background spawn_perturb(const std::vector<std::string>& args, const std::string
   posix_spawn_file_actions_t actions;
   posix_spawn_file_actions_init(&actions);
   posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
-  posix_spawn_file_actions_addopen(&actions, 1, b.out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  posix_spawn_file_actions_addopen(&actions, 2, b.err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_addopen(&actions, 1, b.out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC,
+                                   0644);
+  posix_spawn_file_actions_addopen(&actions, 2, b.err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC,
+                                   0644);
   b.started = Clock::now();
   const int rc = posix_spawn(&b.pid, tool.c_str(), &actions, nullptr, argv.data(), environ);
   posix_spawn_file_actions_destroy(&actions);
@@ -221,8 +227,8 @@ ino_t inode_of(const std::string& path) {
 // Waits until the bundle at `path` has been replaced by a checkpoint (its inode changes) while
 // the process still runs. False when the process ended first (it is then reaped: b.pid = -1,
 // `exit_code` set) or after the timeout.
-bool wait_for_checkpoint(Background& b, const std::string& path, ino_t before, double timeout_seconds,
-                         int& exit_code) {
+bool wait_for_checkpoint(Background& b, const std::string& path, ino_t before,
+                         double timeout_seconds, int& exit_code) {
   const auto until = Clock::now() + std::chrono::duration<double>(timeout_seconds);
   while (Clock::now() < until) {
     int status = 0;
@@ -246,15 +252,18 @@ void sleep_until(Clock::time_point t) { std::this_thread::sleep_until(t); }
 
 // Bit-for-bit equality of two arrays, reporting the first difference.
 template <typename T>
-::testing::AssertionResult same_array(const std::string& name, const std::vector<T>& a, const std::vector<T>& b) {
+::testing::AssertionResult same_array(const std::string& name, const std::vector<T>& a,
+                                      const std::vector<T>& b) {
   if (a.size() != b.size()) {
-    return ::testing::AssertionFailure() << name << ": " << a.size() << " vs " << b.size() << " values";
+    return ::testing::AssertionFailure()
+           << name << ": " << a.size() << " vs " << b.size() << " values";
   }
   for (size_t i = 0; i < a.size(); ++i) {
     if (std::memcmp(&a[i], &b[i], sizeof(T)) != 0) {
       std::ostringstream o;
       o.precision(17);
-      o << name << ": first difference at element " << i << " of " << a.size() << ": " << a[i] << " vs " << b[i];
+      o << name << ": first difference at element " << i << " of " << a.size() << ": " << a[i]
+        << " vs " << b[i];
       return ::testing::AssertionFailure() << o.str();
     }
   }
@@ -290,7 +299,8 @@ void expect_same_edges(const Bundle& a, const Bundle& b) {
   EXPECT_EQ(x.rejected, y.rejected);
   EXPECT_TRUE(same_double(x.design_theta, y.design_theta));
   EXPECT_TRUE(same_double(x.simulated_seconds, y.simulated_seconds));
-  EXPECT_TRUE(same_double(x.wall_seconds, y.wall_seconds)) << "the build's wall_seconds was changed";
+  EXPECT_TRUE(same_double(x.wall_seconds, y.wall_seconds))
+      << "the build's wall_seconds was changed";
 }
 
 // The two analyses hold the same numbers: settings and every per-edge dataset bit for bit.
@@ -309,10 +319,12 @@ void expect_same_perturbation(const Perturbation& a, const Perturbation& b, bool
   EXPECT_TRUE(same_array("perturbation/max_error", a.max_error, b.max_error));
   EXPECT_TRUE(same_array("perturbation/p_lazy_prop", a.p_lazy_prop, b.p_lazy_prop));
   EXPECT_TRUE(same_array("perturbation/p_collision", a.p_collision, b.p_collision));
-  EXPECT_NEAR(a.simulated_seconds, b.simulated_seconds, 1e-9 * std::max(1.0, std::abs(b.simulated_seconds)));
+  EXPECT_NEAR(a.simulated_seconds, b.simulated_seconds,
+              1e-9 * std::max(1.0, std::abs(b.simulated_seconds)));
   if (work) {
     EXPECT_TRUE(same_double(a.simulated_seconds, b.simulated_seconds));
-    EXPECT_TRUE(same_double(a.wall_seconds, b.wall_seconds)) << a.wall_seconds << " vs " << b.wall_seconds;
+    EXPECT_TRUE(same_double(a.wall_seconds, b.wall_seconds))
+        << a.wall_seconds << " vs " << b.wall_seconds;
   }
 }
 
@@ -337,17 +349,19 @@ size_t check_invariants(const Bundle& b) {
   for (size_t e = 0; e < N && reported < 5; ++e) {
     std::ostringstream where;
     where.precision(17);
-    where << "edge " << e << ": done " << p.done[e] << ", valid " << p.valid[e] << ", lazy " << p.lazy[e]
-          << ", collision " << p.collision[e] << ", max_error " << p.max_error[e] << ", p_lazy_prop "
-          << p.p_lazy_prop[e] << ", p_collision " << p.p_collision[e];
+    where << "edge " << e << ": done " << p.done[e] << ", valid " << p.valid[e] << ", lazy "
+          << p.lazy[e] << ", collision " << p.collision[e] << ", max_error " << p.max_error[e]
+          << ", p_lazy_prop " << p.p_lazy_prop[e] << ", p_collision " << p.p_collision[e];
     std::string problems;
     // An edge is processed whole: 0 or p done.
     if (p.done[e] != 0 && p.done[e] != p.perturbations) problems += " done is neither 0 nor p;";
     finished += p.done[e] == p.perturbations;
     if (p.valid[e] + p.collision[e] > p.done[e]) problems += " valid + collision > done;";
     if (p.lazy[e] > p.valid[e]) problems += " lazy > valid;";
-    if (!(p.p_lazy_prop[e] >= 0 && p.p_lazy_prop[e] <= 1)) problems += " p_lazy_prop outside [0, 1];";
-    if (!(p.p_collision[e] >= 0 && p.p_collision[e] <= 1)) problems += " p_collision outside [0, 1];";
+    if (!(p.p_lazy_prop[e] >= 0 && p.p_lazy_prop[e] <= 1))
+      problems += " p_lazy_prop outside [0, 1];";
+    if (!(p.p_collision[e] >= 0 && p.p_collision[e] <= 1))
+      problems += " p_collision outside [0, 1];";
     const double lazy_prop = p.valid[e] ? static_cast<double>(p.lazy[e]) / p.valid[e] : 0.0;
     if (!same_double(p.p_lazy_prop[e], lazy_prop)) problems += " p_lazy_prop != lazy / valid;";
     const double collision = p.done[e] ? static_cast<double>(p.collision[e]) / p.done[e] : 0.0;
@@ -370,15 +384,17 @@ size_t check_invariants(const Bundle& b) {
 // ------------------------------------------------------------------------------------------
 
 // A complete bundle of `edges` edges on `env`, built once; never modified (tests copy it).
-const std::string& input_bundle(uint64_t edges, uint64_t seed, const std::string& env = "table.json") {
+const std::string& input_bundle(uint64_t edges, uint64_t seed,
+                                const std::string& env = "table.json") {
   static std::map<std::string, std::string> cache;
   const std::string key = std::to_string(edges) + "-" + std::to_string(seed) + "-" + env;
   const auto it = cache.find(key);
   if (it != cache.end()) return it->second;
   const std::string dir = fresh_dir("input-" + key);
   const std::string out = dir + "/input.h5";
-  const CommandResult r = build_tool({"--out", out, "--edges", std::to_string(edges), "--seed", std::to_string(seed),
-                                      "--env", env_file(env), "--threads", "2", "--quiet"});
+  const CommandResult r =
+      build_tool({"--out", out, "--edges", std::to_string(edges), "--seed", std::to_string(seed),
+                  "--env", env_file(env), "--threads", "2", "--quiet"});
   EXPECT_EQ(r.exit_code, 0) << "input build: " << describe(r);
   return cache[key] = out;
 }
@@ -465,7 +481,8 @@ const BasicRun& basic_run() {
   const std::string dir = fresh_dir("basic");
   run.path = dir + "/b.h5";
   copy_bundle(input, run.path);
-  run.result = perturb_tool({"--bundle", run.path, "--perturbations", std::to_string(kBasicP), "--threads", "2"});
+  run.result = perturb_tool(
+      {"--bundle", run.path, "--perturbations", std::to_string(kBasicP), "--threads", "2"});
   run.files = files_in(dir);
   run.after = read_bundle(run.path);
   return run;
@@ -518,9 +535,12 @@ TEST(PerturbCli, BasicRunWritesConsistentProbabilities) {
       const char* name;
       hid_t type;
     } expected[] = {
-        {"/perturbation/done", H5T_STD_U64LE},        {"/perturbation/valid", H5T_STD_U64LE},
-        {"/perturbation/lazy", H5T_STD_U64LE},        {"/perturbation/collision", H5T_STD_U64LE},
-        {"/perturbation/max_error", H5T_IEEE_F64LE},  {"/perturbation/p_lazy_prop", H5T_IEEE_F64LE},
+        {"/perturbation/done", H5T_STD_U64LE},
+        {"/perturbation/valid", H5T_STD_U64LE},
+        {"/perturbation/lazy", H5T_STD_U64LE},
+        {"/perturbation/collision", H5T_STD_U64LE},
+        {"/perturbation/max_error", H5T_IEEE_F64LE},
+        {"/perturbation/p_lazy_prop", H5T_IEEE_F64LE},
         {"/perturbation/p_collision", H5T_IEEE_F64LE},
     };
     for (const auto& e : expected) {
@@ -561,7 +581,8 @@ TEST(PerturbCli, SameNumbersWhateverTheThreadCount) {
   const std::string dir = fresh_dir("threads");
   const std::string one = dir + "/one.h5";
   copy_bundle(input, one);
-  const CommandResult r = perturb_tool({"--bundle", one, "--perturbations", "4", "--seed", "3", "--threads", "1", "--quiet"});
+  const CommandResult r = perturb_tool(
+      {"--bundle", one, "--perturbations", "4", "--seed", "3", "--threads", "1", "--quiet"});
   ASSERT_EQ(r.exit_code, 0) << describe(r);
   EXPECT_EQ(r.out, "");
   EXPECT_EQ(r.err, "");
@@ -588,24 +609,29 @@ TEST(PerturbCli, ExtendRerunRefuseAndReplace) {
 
   // p = 4, then p = 8 with the same seed and theta: equal to a fresh p = 8 run.
   {
-    const CommandResult r4 = perturb_tool({"--bundle", path, "--perturbations", "4", "--seed", "3", "--threads", "2", "--quiet"});
+    const CommandResult r4 = perturb_tool(
+        {"--bundle", path, "--perturbations", "4", "--seed", "3", "--threads", "2", "--quiet"});
     ASSERT_EQ(r4.exit_code, 0) << describe(r4);
     const Bundle b4 = read_bundle(path);
     EXPECT_EQ(b4.perturbation.perturbations, 4u);
-    expect_same_perturbation(b4.perturbation, reference(input, {"--perturbations", "4", "--seed", "3"}).perturbation);
-    const CommandResult r8 = perturb_tool({"--bundle", path, "--perturbations", "8", "--seed", "3", "--threads", "2", "--quiet"});
+    expect_same_perturbation(
+        b4.perturbation, reference(input, {"--perturbations", "4", "--seed", "3"}).perturbation);
+    const CommandResult r8 = perturb_tool(
+        {"--bundle", path, "--perturbations", "8", "--seed", "3", "--threads", "2", "--quiet"});
     ASSERT_EQ(r8.exit_code, 0) << describe(r8);
     const Bundle b8 = read_bundle(path);
     EXPECT_TRUE(b8.perturbation.complete);
     EXPECT_EQ(check_invariants(b8), kSmallEdges);
-    expect_same_perturbation(b8.perturbation, reference(input, {"--perturbations", "8", "--seed", "3"}).perturbation);
+    expect_same_perturbation(
+        b8.perturbation, reference(input, {"--perturbations", "8", "--seed", "3"}).perturbation);
     expect_same_edges(b8, original);
   }
 
   // The same settings again on a complete analysis: says so, changes nothing.
   {
     const Bundle before = read_bundle(path);
-    const CommandResult again = perturb_tool({"--bundle", path, "--perturbations", "8", "--seed", "3", "--threads", "2"});
+    const CommandResult again =
+        perturb_tool({"--bundle", path, "--perturbations", "8", "--seed", "3", "--threads", "2"});
     ASSERT_EQ(again.exit_code, 0) << describe(again);
     EXPECT_TRUE(contains(again.err, "already")) << describe(again);
     EXPECT_TRUE(contains(again.err, path)) << describe(again);
@@ -622,9 +648,13 @@ TEST(PerturbCli, ExtendRerunRefuseAndReplace) {
     std::vector<std::string> needles;
   } refusals[] = {
       {"fewer perturbations", {"--perturbations", "4", "--seed", "3"}, {"--replace"}},
-      {"another theta", {"--perturbations", "8", "--seed", "3", "--theta", "0.3"}, {"--replace", "theta"}},
+      {"another theta",
+       {"--perturbations", "8", "--seed", "3", "--theta", "0.3"},
+       {"--replace", "theta"}},
       {"another seed", {"--perturbations", "8", "--seed", "4"}, {"--replace", "--seed"}},
-      {"another seed and more perturbations", {"--perturbations", "12", "--seed", "4"}, {"--replace", "--seed"}},
+      {"another seed and more perturbations",
+       {"--perturbations", "12", "--seed", "4"},
+       {"--replace", "--seed"}},
   };
   for (const auto& refusal : refusals) {
     SCOPED_TRACE(refusal.name);
@@ -641,27 +671,31 @@ TEST(PerturbCli, ExtendRerunRefuseAndReplace) {
 
   // --replace: equal to a fresh run with the new settings.
   {
-    const CommandResult r = perturb_tool({"--bundle", path, "--replace", "--theta", "0.3", "--perturbations", "4", "--seed",
-                                          "3", "--threads", "2", "--quiet"});
+    const CommandResult r =
+        perturb_tool({"--bundle", path, "--replace", "--theta", "0.3", "--perturbations", "4",
+                      "--seed", "3", "--threads", "2", "--quiet"});
     ASSERT_EQ(r.exit_code, 0) << describe(r);
     const Bundle b = read_bundle(path);
     EXPECT_TRUE(same_double(b.perturbation.theta, 0.3));
-    expect_same_perturbation(b.perturbation,
-                             reference(input, {"--theta", "0.3", "--perturbations", "4", "--seed", "3"}).perturbation);
+    expect_same_perturbation(
+        b.perturbation,
+        reference(input, {"--theta", "0.3", "--perturbations", "4", "--seed", "3"}).perturbation);
     expect_same_edges(b, original);
   }
   {
     // Back to the design theta (not given: the default) with another seed.
-    const CommandResult r = perturb_tool({"--bundle", path, "--replace", "--perturbations", "4", "--seed", "4", "--threads",
-                                          "2", "--quiet"});
+    const CommandResult r = perturb_tool({"--bundle", path, "--replace", "--perturbations", "4",
+                                          "--seed", "4", "--threads", "2", "--quiet"});
     ASSERT_EQ(r.exit_code, 0) << describe(r);
     const Bundle b = read_bundle(path);
     EXPECT_TRUE(same_double(b.perturbation.theta, original.header.design_theta));
-    expect_same_perturbation(b.perturbation, reference(input, {"--perturbations", "4", "--seed", "4"}).perturbation);
+    expect_same_perturbation(
+        b.perturbation, reference(input, {"--perturbations", "4", "--seed", "4"}).perturbation);
     expect_same_edges(b, original);
     // A different seed gives different perturbations (the counts of some edge differ).
     const Perturbation& s3 = reference(input, {"--perturbations", "4", "--seed", "3"}).perturbation;
-    EXPECT_FALSE(same_array("max_error", b.perturbation.max_error, s3.max_error)) << "seeds 3 and 4 gave the same errors";
+    EXPECT_FALSE(same_array("max_error", b.perturbation.max_error, s3.max_error))
+        << "seeds 3 and 4 gave the same errors";
   }
   EXPECT_TRUE(tmp_files_in(dir).empty()) << join(tmp_files_in(dir));
 }
@@ -676,7 +710,8 @@ constexpr double kLongTheta = 0.3141592653589793;
 const char* const kLongThetaText = "0.3141592653589793";
 
 std::vector<std::string> long_args(const std::string& path) {
-  return {"--bundle", path, "--perturbations", "16", "--theta", kLongThetaText, "--seed", "5", "--threads", "2", "--quiet"};
+  return {"--bundle", path, "--perturbations", "16", "--theta", kLongThetaText,
+          "--seed",   "5",  "--threads",       "2",  "--quiet"};
 }
 
 const Bundle& long_reference() {
@@ -715,7 +750,8 @@ TEST(PerturbCli, InterruptedRunResumesToTheUninterruptedResult) {
     ::kill(b.pid, SIGINT);
   }
   const int code = b.pid > 0 ? wait_for(b) : early_exit;
-  ASSERT_TRUE(checkpointed) << "no checkpoint before the run ended (exit " << code << "): make the run longer\n"
+  ASSERT_TRUE(checkpointed) << "no checkpoint before the run ended (exit " << code
+                            << "): make the run longer\n"
                             << read_file(b.err_path);
   const std::string err = read_file(b.err_path);
   EXPECT_EQ(code, 130) << err;
@@ -755,7 +791,8 @@ TEST(PerturbCli, InterruptedRunResumesToTheUninterruptedResult) {
   for (size_t e = 0; e < partial.size(); ++e) {
     if (partial.perturbation.done[e] == 0) continue;
     ASSERT_EQ(partial.perturbation.lazy[e], straight.perturbation.lazy[e]) << "edge " << e;
-    ASSERT_EQ(partial.perturbation.collision[e], straight.perturbation.collision[e]) << "edge " << e;
+    ASSERT_EQ(partial.perturbation.collision[e], straight.perturbation.collision[e])
+        << "edge " << e;
   }
 
   // The same command again completes it.
@@ -769,7 +806,8 @@ TEST(PerturbCli, InterruptedRunResumesToTheUninterruptedResult) {
   EXPECT_EQ(check_invariants(full), kLongEdges);
   expect_same_perturbation(full.perturbation, straight.perturbation);
   expect_same_edges(full, original);
-  EXPECT_GE(full.perturbation.wall_seconds, partial.perturbation.wall_seconds) << "work time of the first part lost";
+  EXPECT_GE(full.perturbation.wall_seconds, partial.perturbation.wall_seconds)
+      << "work time of the first part lost";
 }
 
 TEST(PerturbCli, KilledRunLeavesAValidResumableBundle) {
@@ -792,8 +830,10 @@ TEST(PerturbCli, KilledRunLeavesAValidResumableBundle) {
     ::kill(b.pid, SIGKILL);
   }
   const int code = b.pid > 0 ? wait_for(b) : early_exit;
-  ASSERT_TRUE(checkpointed) << "no checkpoint before the run ended (exit " << code << ")\n" << read_file(b.err_path);
-  ASSERT_EQ(code, -SIGKILL) << "the run ended before the kill: make it longer\n" << read_file(b.err_path);
+  ASSERT_TRUE(checkpointed) << "no checkpoint before the run ended (exit " << code << ")\n"
+                            << read_file(b.err_path);
+  ASSERT_EQ(code, -SIGKILL) << "the run ended before the kill: make it longer\n"
+                            << read_file(b.err_path);
 
   // Only the killed process's own temporary file may remain.
   const std::string own_tmp = "run.h5.tmp." + std::to_string(pid);
@@ -847,9 +887,15 @@ void expect_refused(const BadCase& c, const std::string& input, const std::strin
   const CommandResult r = perturb_tool_in(dir, args);
   expect_one_line_error(r, needles);
   switch (c.exit) {
-    case Exit::One: EXPECT_EQ(r.exit_code, 1) << describe(r); break;
-    case Exit::CommandLine: EXPECT_GE(r.exit_code, 2) << describe(r); break;
-    case Exit::Either: EXPECT_GE(r.exit_code, 1) << describe(r); break;
+    case Exit::One:
+      EXPECT_EQ(r.exit_code, 1) << describe(r);
+      break;
+    case Exit::CommandLine:
+      EXPECT_GE(r.exit_code, 2) << describe(r);
+      break;
+    case Exit::Either:
+      EXPECT_GE(r.exit_code, 1) << describe(r);
+      break;
   }
   const auto after = snapshot(dir);
   std::vector<std::string> names_before, names_after;
@@ -861,7 +907,8 @@ void expect_refused(const BadCase& c, const std::string& input, const std::strin
 
 // A copy of the Panda's config and URDF in `dir`; `edit` may change the URDF text.
 void copy_robot(const std::string& dir, const std::function<void(std::string&)>& edit = nullptr) {
-  fs::copy_file(source_path("data/robots/panda.json"), dir + "/panda.json", fs::copy_options::overwrite_existing);
+  fs::copy_file(source_path("data/robots/panda.json"), dir + "/panda.json",
+                fs::copy_options::overwrite_existing);
   std::string urdf = read_file(source_path("data/robots/panda.urdf"));
   if (edit) edit(urdf);
   write_bytes(dir + "/panda.urdf", urdf);
@@ -907,23 +954,45 @@ TEST(PerturbCli, BadInputIsOneLineAndChangesNothing) {
        {"@DIR/panda.json", "not the robot"},
        Exit::One,
        [](const std::string& dir) { copy_robot(dir, change_a_mass); }},
-      {"another environment", {"--bundle", "@BUNDLE", "--env", env_file("shelf.json")}, {"shelf.json", "not the environment"}},
-      {"missing robot file", {"--bundle", "@BUNDLE", "--robot", "@DIR/nope.json"}, {"@DIR/nope.json"}},
-      {"missing environment file", {"--bundle", "@BUNDLE", "--env", "@DIR/nope.json"}, {"@DIR/nope.json"}},
-      {"perturbations 0", {"--bundle", "@BUNDLE", "--perturbations", "0"}, {"--perturbations"}, Exit::CommandLine},
-      {"perturbations -1", {"--bundle", "@BUNDLE", "--perturbations", "-1"}, {"--perturbations"}, Exit::CommandLine},
-      {"perturbations abc", {"--bundle", "@BUNDLE", "--perturbations", "abc"}, {"--perturbations"}, Exit::CommandLine},
-      {"perturbations too many", {"--bundle", "@BUNDLE", "--perturbations", "16777216"}, {"--perturbations"}, Exit::Either},
+      {"another environment",
+       {"--bundle", "@BUNDLE", "--env", env_file("shelf.json")},
+       {"shelf.json", "not the environment"}},
+      {"missing robot file",
+       {"--bundle", "@BUNDLE", "--robot", "@DIR/nope.json"},
+       {"@DIR/nope.json"}},
+      {"missing environment file",
+       {"--bundle", "@BUNDLE", "--env", "@DIR/nope.json"},
+       {"@DIR/nope.json"}},
+      {"perturbations 0",
+       {"--bundle", "@BUNDLE", "--perturbations", "0"},
+       {"--perturbations"},
+       Exit::CommandLine},
+      {"perturbations -1",
+       {"--bundle", "@BUNDLE", "--perturbations", "-1"},
+       {"--perturbations"},
+       Exit::CommandLine},
+      {"perturbations abc",
+       {"--bundle", "@BUNDLE", "--perturbations", "abc"},
+       {"--perturbations"},
+       Exit::CommandLine},
+      {"perturbations too many",
+       {"--bundle", "@BUNDLE", "--perturbations", "16777216"},
+       {"--perturbations"},
+       Exit::Either},
       {"theta -1", {"--bundle", "@BUNDLE", "--theta", "-1"}, {"--theta"}, Exit::Either},
       {"theta 0", {"--bundle", "@BUNDLE", "--theta", "0"}, {"--theta"}, Exit::Either},
       {"theta nan", {"--bundle", "@BUNDLE", "--theta", "nan"}, {"--theta"}, Exit::Either},
       {"theta abc", {"--bundle", "@BUNDLE", "--theta", "abc"}, {"--theta"}, Exit::CommandLine},
       {"seed -3", {"--bundle", "@BUNDLE", "--seed", "-3"}, {"--seed"}, Exit::CommandLine},
       {"threads x", {"--bundle", "@BUNDLE", "--threads", "x"}, {"--threads"}, Exit::CommandLine},
-      {"checkpoint -1", {"--bundle", "@BUNDLE", "--checkpoint-seconds", "-1"}, {"--checkpoint-seconds"}, Exit::CommandLine},
+      {"checkpoint -1",
+       {"--bundle", "@BUNDLE", "--checkpoint-seconds", "-1"},
+       {"--checkpoint-seconds"},
+       Exit::CommandLine},
       {"unknown option", {"--bundle", "@BUNDLE", "--bogus"}, {"--bogus"}, Exit::CommandLine},
   };
-  for (size_t k = 0; k < cases.size(); ++k) expect_refused(cases[k], input, "bad-" + std::to_string(k));
+  for (size_t k = 0; k < cases.size(); ++k)
+    expect_refused(cases[k], input, "bad-" + std::to_string(k));
 }
 
 // The robot and environment are checked by content, not by path: identical copies elsewhere
@@ -935,8 +1004,9 @@ TEST(PerturbCli, RobotAndEnvironmentAreCheckedByContent) {
   copy_bundle(input, path);
   copy_robot(dir);
   fs::copy_file(env_file("table.json"), dir + "/table.json");
-  const CommandResult r = perturb_tool({"--bundle", path, "--robot", dir + "/panda.json", "--env", dir + "/table.json",
-                                        "--perturbations", "1", "--threads", "2", "--quiet"});
+  const CommandResult r =
+      perturb_tool({"--bundle", path, "--robot", dir + "/panda.json", "--env", dir + "/table.json",
+                    "--perturbations", "1", "--threads", "2", "--quiet"});
   ASSERT_EQ(r.exit_code, 0) << describe(r);
   const Bundle b = read_bundle(path);
   EXPECT_TRUE(b.perturbation.complete);
@@ -959,7 +1029,8 @@ TEST(PerturbCli, ProbabilitiesArePlausibleOnTheTable) {
   ASSERT_TRUE(p.complete);
   ASSERT_EQ(p.p_collision.size(), kBasicEdges);
   const double n = static_cast<double>(kBasicEdges);
-  const double mean_collision = std::accumulate(p.p_collision.begin(), p.p_collision.end(), 0.0) / n;
+  const double mean_collision =
+      std::accumulate(p.p_collision.begin(), p.p_collision.end(), 0.0) / n;
   const double mean_lazy = std::accumulate(p.p_lazy_prop.begin(), p.p_lazy_prop.end(), 0.0) / n;
   EXPECT_GT(mean_collision, 0) << "no perturbation of any edge collides with the table";
   EXPECT_LT(mean_collision, 0.5);
@@ -978,8 +1049,10 @@ TEST(PerturbCli, ProbabilitiesArePlausibleOnTheTable) {
   EXPECT_GT(lazy, 0u);
   EXPECT_LT(lazy, valid);
   EXPECT_GT(collision, 0u);
-  std::printf("[ info     ] mean P_collision %.3f, mean P_lazy_prop %.3f, rollouts valid %.1f%%, collided %.1f%%\n",
-              mean_collision, mean_lazy, 100.0 * valid / done, 100.0 * collision / done);
+  std::printf(
+      "[ info     ] mean P_collision %.3f, mean P_lazy_prop %.3f, rollouts valid %.1f%%, collided "
+      "%.1f%%\n",
+      mean_collision, mean_lazy, 100.0 * valid / done, 100.0 * collision / done);
 }
 
 }  // namespace

@@ -42,7 +42,8 @@ TEST(RobotModel, PandaHasSevenJointsWithPublishedLimits) {
 TEST(RobotModel, CylinderWithSphereCapsBecomesOneCapsule) {
   const RobotModel& robot = test::panda();
   ASSERT_EQ(robot.collision_bodies.size(), 10u);  // Franka's ten coarse capsules
-  for (const CollisionBody& c : robot.collision_bodies) EXPECT_EQ(c.shape.type, ShapeType::Capsule) << c.name;
+  for (const CollisionBody& c : robot.collision_bodies)
+    EXPECT_EQ(c.shape.type, ShapeType::Capsule) << c.name;
   const CollisionBody& link1 = robot.collision_bodies[1];
   EXPECT_EQ(robot.links[link1.link].name, "panda_link1");
   EXPECT_NEAR(link1.shape.radius, 0.06, 1e-12);

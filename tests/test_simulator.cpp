@@ -7,11 +7,10 @@
 #include <cstdlib>
 #include <new>
 
+#include "alloc_counter.h"
 #include "bundle/builder.h"
 #include "sim/simulator.h"
-#include "alloc_counter.h"
 #include "test_util.h"
-
 
 namespace lazyboe {
 namespace {
@@ -26,7 +25,8 @@ BuildSettings default_settings(const RobotModel& robot) {
 }
 
 CommandProfile view(const EdgeAttempt& e, int dof) {
-  return CommandProfile{e.knots.data(), static_cast<int>(e.knots.size() / dof), dof, e.command_duration};
+  return CommandProfile{e.knots.data(), static_cast<int>(e.knots.size() / dof), dof,
+                        e.command_duration};
 }
 
 TEST(CommandProfile, StartsAndEndsAtRestWithinLimitsAtControlRate) {
@@ -65,8 +65,10 @@ TEST(CommandProfile, StartsAndEndsAtRestWithinLimitsAtControlRate) {
         EXPECT_LE(std::abs(v[i]), robot.dq_max[i]);
         // Finite differences at 1 kHz, as the robot's controller checks the stream.
         const double acc = (v[i] - v_prev[i]) / dt, jerk = (acc - a_prev[i]) / dt;
-        EXPECT_LE(std::abs(acc), sampling.limit_scale * robot.ddq_max[i] * 1.001) << "tick " << tick;
-        EXPECT_LE(std::abs(jerk), sampling.limit_scale * robot.dddq_max[i] * 1.001) << "tick " << tick;
+        EXPECT_LE(std::abs(acc), sampling.limit_scale * robot.ddq_max[i] * 1.001)
+            << "tick " << tick;
+        EXPECT_LE(std::abs(jerk), sampling.limit_scale * robot.dddq_max[i] * 1.001)
+            << "tick " << tick;
         EXPECT_NEAR(a[i], acc, robot.dddq_max[i] * dt);
         EXPECT_NEAR(off[i], integral[i], 1e-7);
         v_prev[i] = v[i];
@@ -93,7 +95,8 @@ TEST(Simulator, ValidRolloutsStartAndEndAtRestAndStayCollisionFree) {
     ASSERT_GE(rows, 2u);
     for (int i = 0; i < 7; ++i) {
       EXPECT_EQ(e.sample_dq[i], 0.0f);  // starts at rest
-      EXPECT_LE(std::abs(e.sample_dq[(rows - 1) * 7 + i]), scene.sim.options.settle_velocity * 1.0001);
+      EXPECT_LE(std::abs(e.sample_dq[(rows - 1) * 7 + i]),
+                scene.sim.options.settle_velocity * 1.0001);
       EXPECT_FLOAT_EQ(e.sample_q[(rows - 1) * 7 + i], static_cast<float>(e.qf[i]));
     }
     EXPECT_GT(e.duration, e.command_duration);  // includes settling
@@ -102,7 +105,8 @@ TEST(Simulator, ValidRolloutsStartAndEndAtRestAndStayCollisionFree) {
     for (size_t r = 0; r < rows; ++r) {
       JointVector q(7);
       for (int i = 0; i < 7; ++i) q[i] = e.sample_q[r * 7 + i];
-      EXPECT_EQ(check_state(scene.sim, ws, q), RolloutStatus::Valid) << "attempt " << a << " row " << r;
+      EXPECT_EQ(check_state(scene.sim, ws, q), RolloutStatus::Valid)
+          << "attempt " << a << " row " << r;
     }
   }
   EXPECT_GT(valid, 40);

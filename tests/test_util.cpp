@@ -16,7 +16,9 @@ std::string source_path(const std::string& relative) {
   return std::string(LAZYBOE_SOURCE_DIR) + "/" + relative;
 }
 
-std::string tool_path(const std::string& tool) { return std::string(LAZYBOE_TOOLS_DIR) + "/" + tool; }
+std::string tool_path(const std::string& tool) {
+  return std::string(LAZYBOE_TOOLS_DIR) + "/" + tool;
+}
 
 const RobotModel& panda() {
   static const RobotModel model = load_robot(source_path("data/robots/panda.json"));

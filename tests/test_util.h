@@ -10,7 +10,7 @@
 namespace lazyboe::test {
 
 std::string source_path(const std::string& relative);  // inside the repository
-std::string tool_path(const std::string& tool);         // build/bin/<tool>
+std::string tool_path(const std::string& tool);        // build/bin/<tool>
 
 const RobotModel& panda();  // loaded once per test binary
 

@@ -18,7 +18,8 @@ using namespace lazyboe;
 
 // --region: "default" (the robot config's sampling_region), "limits" (the joint limits), a JSON
 // file {"lower": [...], "upper": [...]}, or inline "lo1:hi1,lo2:hi2,...".
-void parse_region(const std::string& text, const RobotModel& robot, JointVector& lower, JointVector& upper) {
+void parse_region(const std::string& text, const RobotModel& robot, JointVector& lower,
+                  JointVector& upper) {
   const int n = robot.dof;
   if (text == "default") {
     lower = robot.region_lower;
@@ -37,8 +38,10 @@ void parse_region(const std::string& text, const RobotModel& robot, JointVector&
     const JsonField root(doc, text, "");
     root.allow_only({"description", "lower", "upper"});
     const std::vector<double> lo = root.at("lower").numbers(), hi = root.at("upper").numbers();
-    if (static_cast<int>(lo.size()) != n) root.at("lower").fail("expected " + std::to_string(n) + " values");
-    if (static_cast<int>(hi.size()) != n) root.at("upper").fail("expected " + std::to_string(n) + " values");
+    if (static_cast<int>(lo.size()) != n)
+      root.at("lower").fail("expected " + std::to_string(n) + " values");
+    if (static_cast<int>(hi.size()) != n)
+      root.at("upper").fail("expected " + std::to_string(n) + " values");
     for (int i = 0; i < n; ++i) {
       lower[i] = lo[i];
       upper[i] = hi[i];
@@ -52,15 +55,19 @@ void parse_region(const std::string& text, const RobotModel& robot, JointVector&
     double lo = 0, hi = 0;
     char colon = 0, extra = 0;
     std::istringstream is(item);
-    if (!(is >> lo >> colon >> hi) || colon != ':' || (is >> extra) || !std::isfinite(lo) || !std::isfinite(hi)) {
-      fail("--region", "'" + text + "' is not a file, 'default', 'limits', or lo:hi pairs (bad item '" + item + "')");
+    if (!(is >> lo >> colon >> hi) || colon != ':' || (is >> extra) || !std::isfinite(lo) ||
+        !std::isfinite(hi)) {
+      fail("--region", "'" + text +
+                           "' is not a file, 'default', 'limits', or lo:hi pairs (bad item '" +
+                           item + "')");
     }
     if (i >= n) fail("--region", "more than " + std::to_string(n) + " lo:hi pairs");
     lower[i] = lo;
     upper[i] = hi;
     ++i;
   }
-  if (i != n) fail("--region", "expected " + std::to_string(n) + " lo:hi pairs, got " + std::to_string(i));
+  if (i != n)
+    fail("--region", "expected " + std::to_string(n) + " lo:hi pairs, got " + std::to_string(i));
 }
 
 Integrator parse_integrator(const std::string& name) {
@@ -71,15 +78,20 @@ Integrator parse_integrator(const std::string& name) {
 
 void print_summary(const Bundle& b) {
   const BundleHeader& h = b.header;
-  std::fprintf(stderr, "lazyboe-build: %zu edges (%s)\n", b.size(), h.complete ? "complete" : "incomplete");
+  std::fprintf(stderr, "lazyboe-build: %zu edges (%s)\n", b.size(),
+               h.complete ? "complete" : "incomplete");
   std::fprintf(stderr, "  attempts %llu, valid %llu (%.1f%%), start states resampled %llu\n",
-               static_cast<unsigned long long>(h.attempts), static_cast<unsigned long long>(h.valid),
-               h.attempts ? 100.0 * h.valid / h.attempts : 0.0, static_cast<unsigned long long>(h.start_resamples));
+               static_cast<unsigned long long>(h.attempts),
+               static_cast<unsigned long long>(h.valid),
+               h.attempts ? 100.0 * h.valid / h.attempts : 0.0,
+               static_cast<unsigned long long>(h.start_resamples));
   for (const auto& [reason, count] : h.rejected) {
-    std::fprintf(stderr, "  rejected %-20s %llu\n", reason.c_str(), static_cast<unsigned long long>(count));
+    std::fprintf(stderr, "  rejected %-20s %llu\n", reason.c_str(),
+                 static_cast<unsigned long long>(count));
   }
   std::fprintf(stderr, "  simulated %.1f s in %.1f s wall: %.0f attempts/s, %.0f valid edges/s\n",
-               h.simulated_seconds, h.wall_seconds, h.wall_seconds > 0 ? h.attempts / h.wall_seconds : 0.0,
+               h.simulated_seconds, h.wall_seconds,
+               h.wall_seconds > 0 ? h.attempts / h.wall_seconds : 0.0,
                h.wall_seconds > 0 ? h.valid / h.wall_seconds : 0.0);
 }
 
@@ -96,29 +108,45 @@ int main(int argc, char** argv) {
   app.add_option("--robot", robot_path, "Robot config (JSON)")->capture_default_str();
   app.add_option("--env", env_path, "Environment (JSON)")->capture_default_str();
   app.add_option("--out", out_path, "Bundle file to write (HDF5)");
-  app.add_option("--edges", s.edges, "Valid edges to generate")->capture_default_str()->check(whole_number(false));
+  app.add_option("--edges", s.edges, "Valid edges to generate")
+      ->capture_default_str()
+      ->check(whole_number(false));
   app.add_option("--seed", s.seed, "Random seed")->capture_default_str()->check(whole_number(true));
-  app.add_option("--threads", control.threads, "Threads (0: all cores)")->capture_default_str()->check(whole_number(true));
-  app.add_option("--region", region,
-                 "Start-state box: default (robot config), limits, a JSON file, or lo:hi,... per joint")
+  app.add_option("--threads", control.threads, "Threads (0: all cores)")
+      ->capture_default_str()
+      ->check(whole_number(true));
+  app.add_option(
+         "--region", region,
+         "Start-state box: default (robot config), limits, a JSON file, or lo:hi,... per joint")
       ->capture_default_str();
-  app.add_option("--min-duration", s.command.min_duration, "Shortest velocity command, s")->capture_default_str();
-  app.add_option("--max-duration", s.command.max_duration, "Longest velocity command, s")->capture_default_str();
-  app.add_option("--knot-interval", s.command.knot_interval, "Nominal spacing of velocity knots, s")->capture_default_str();
-  app.add_option("--velocity-scale", s.command.velocity_scale, "Knot speeds up to this fraction of the velocity limits")
+  app.add_option("--min-duration", s.command.min_duration, "Shortest velocity command, s")
+      ->capture_default_str();
+  app.add_option("--max-duration", s.command.max_duration, "Longest velocity command, s")
+      ->capture_default_str();
+  app.add_option("--knot-interval", s.command.knot_interval, "Nominal spacing of velocity knots, s")
+      ->capture_default_str();
+  app.add_option("--velocity-scale", s.command.velocity_scale,
+                 "Knot speeds up to this fraction of the velocity limits")
       ->capture_default_str();
   app.add_option("--limit-scale", s.command.limit_scale,
-                 "Commanded acceleration and jerk up to this fraction of the limits")->capture_default_str();
+                 "Commanded acceleration and jerk up to this fraction of the limits")
+      ->capture_default_str();
   app.add_option("--integrator", integrator, "euler (semi-implicit) or rk4")->capture_default_str();
-  app.add_option("--substeps", s.simulation.substeps, "Integration steps per control period")->capture_default_str();
-  app.add_option("--sample-interval", sample_interval, "Stored trajectory spacing, s (0: none)")->capture_default_str();
-  app.add_option("--theta", s.design_theta, "Neighbourhood radius the bundle is designed for (rad)")->capture_default_str();
-  app.add_option("--checkpoint-seconds", control.checkpoint_seconds, "Least time between checkpoints")
-      ->capture_default_str()->check(number_at_least_zero());
+  app.add_option("--substeps", s.simulation.substeps, "Integration steps per control period")
+      ->capture_default_str();
+  app.add_option("--sample-interval", sample_interval, "Stored trajectory spacing, s (0: none)")
+      ->capture_default_str();
+  app.add_option("--theta", s.design_theta, "Neighbourhood radius the bundle is designed for (rad)")
+      ->capture_default_str();
+  app.add_option("--checkpoint-seconds", control.checkpoint_seconds,
+                 "Least time between checkpoints")
+      ->capture_default_str()
+      ->check(number_at_least_zero());
   app.add_flag("--resume", resume, "Continue an interrupted build in --out (to --edges)");
   app.add_flag("--force", force, "Overwrite an existing --out");
   app.add_flag("--quiet", control.quiet, "No progress output");
-  app.add_option("--inspect", inspect_path, "Print the header and statistics of a bundle, then exit");
+  app.add_option("--inspect", inspect_path,
+                 "Print the header and statistics of a bundle, then exit");
   one_line_cli_errors(app, "lazyboe-build");
   CLI11_PARSE(app, argc, argv);
 
@@ -135,8 +163,10 @@ int main(int argc, char** argv) {
       fail("--max-duration", "must be >= --min-duration");
     }
     if (!(s.command.knot_interval > 0)) fail("--knot-interval", "must be > 0");
-    if (!(s.command.velocity_scale > 0 && s.command.velocity_scale <= 1)) fail("--velocity-scale", "must be in (0, 1]");
-    if (!(s.command.limit_scale > 0 && s.command.limit_scale <= 1)) fail("--limit-scale", "must be in (0, 1]");
+    if (!(s.command.velocity_scale > 0 && s.command.velocity_scale <= 1))
+      fail("--velocity-scale", "must be in (0, 1]");
+    if (!(s.command.limit_scale > 0 && s.command.limit_scale <= 1))
+      fail("--limit-scale", "must be in (0, 1]");
     if (s.simulation.substeps < 1) fail("--substeps", "must be >= 1");
     if (!(s.design_theta > 0)) fail("--theta", "must be > 0");
     if (control.threads < 0) fail("--threads", "must be >= 0");
@@ -176,10 +206,13 @@ int main(int argc, char** argv) {
     const Environment env = load_environment(env_path);
     const CollisionModel collision = build_collision_model(robot, env);
     s.simulation.sample_every = static_cast<int>(std::lround(sample_interval * robot.control_rate));
-    if (sample_interval > 0 && std::abs(s.simulation.sample_every / robot.control_rate - sample_interval) > 1e-9) {
-      fail("--sample-interval", "must be a multiple of the control period (" + std::to_string(1 / robot.control_rate) + " s)");
+    if (sample_interval > 0 &&
+        std::abs(s.simulation.sample_every / robot.control_rate - sample_interval) > 1e-9) {
+      fail("--sample-interval", "must be a multiple of the control period (" +
+                                    std::to_string(1 / robot.control_rate) + " s)");
     }
-    if (!resume || app.count("--region")) parse_region(region, robot, s.region_lower, s.region_upper);
+    if (!resume || app.count("--region"))
+      parse_region(region, robot, s.region_lower, s.region_upper);
     const Simulator sim(robot, collision, s.simulation);
     check_region(sim, s);
 
@@ -191,7 +224,8 @@ int main(int argc, char** argv) {
       }
       if (existing.size() == s.edges && existing.header.complete) {
         if (!control.quiet) {
-          std::fprintf(stderr, "lazyboe-build: %s is already complete with %zu edges\n", out_path.c_str(), existing.size());
+          std::fprintf(stderr, "lazyboe-build: %s is already complete with %zu edges\n",
+                       out_path.c_str(), existing.size());
         }
         return 0;
       }
@@ -202,7 +236,9 @@ int main(int argc, char** argv) {
         // New edges have no perturbation counts: the analysis has to be run again.
         existing.perturbation = Perturbation{};
         if (!control.quiet) {
-          std::fprintf(stderr, "lazyboe-build: the perturbation analysis in %s is dropped; run lazyboe-perturb again\n",
+          std::fprintf(stderr,
+                       "lazyboe-build: the perturbation analysis in %s is dropped; run "
+                       "lazyboe-perturb again\n",
                        out_path.c_str());
         }
       }
@@ -219,7 +255,9 @@ int main(int argc, char** argv) {
     const BuildOutcome outcome = build_bundle(sim, s, bundle, control);
     if (!control.quiet) print_summary(bundle);
     if (outcome == BuildOutcome::Interrupted) {
-      std::fprintf(stderr, "lazyboe-build: interrupted; %s holds %zu edges. Continue with: lazyboe-build --resume --out %s\n",
+      std::fprintf(stderr,
+                   "lazyboe-build: interrupted; %s holds %zu edges. Continue with: lazyboe-build "
+                   "--resume --out %s\n",
                    out_path.c_str(), bundle.size(), out_path.c_str());
       return 130;
     }

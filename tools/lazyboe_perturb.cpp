@@ -26,16 +26,23 @@ int main(int argc, char** argv) {
   PerturbControl control;
   bool replace = false;
   app.add_option("--bundle", bundle_path, "Bundle file (HDF5), updated in place")->required();
-  app.add_option("--theta", s.theta, "Perturbation radius, rad (default: the bundle's design theta)");
+  app.add_option("--theta", s.theta,
+                 "Perturbation radius, rad (default: the bundle's design theta)");
   app.add_option("--perturbations", s.perturbations, "Perturbations per edge (p)")
-      ->capture_default_str()->check(whole_number(false));
+      ->capture_default_str()
+      ->check(whole_number(false));
   app.add_option("--seed", s.seed, "Random seed")->capture_default_str()->check(whole_number(true));
-  app.add_option("--threads", control.threads, "Threads (0: all cores)")->capture_default_str()->check(whole_number(true));
-  app.add_option("--robot", robot_path, "Robot config (default: the one the bundle was built with)");
+  app.add_option("--threads", control.threads, "Threads (0: all cores)")
+      ->capture_default_str()
+      ->check(whole_number(true));
+  app.add_option("--robot", robot_path,
+                 "Robot config (default: the one the bundle was built with)");
   app.add_option("--env", env_path, "Environment (default: the one the bundle was built with)");
   app.add_flag("--replace", replace, "Discard an existing analysis with other settings");
-  app.add_option("--checkpoint-seconds", control.checkpoint_seconds, "Least time between checkpoints")
-      ->capture_default_str()->check(number_at_least_zero());
+  app.add_option("--checkpoint-seconds", control.checkpoint_seconds,
+                 "Least time between checkpoints")
+      ->capture_default_str()
+      ->check(number_at_least_zero());
   app.add_flag("--quiet", control.quiet, "No progress or summary output");
   one_line_cli_errors(app, "lazyboe-perturb");
   CLI11_PARSE(app, argc, argv);
@@ -73,8 +80,9 @@ int main(int argc, char** argv) {
     prepare_perturbation(bundle, s, replace, bundle_path);
     if (bundle.perturbation.complete) {
       if (!control.quiet) {
-        std::fprintf(stderr, "lazyboe-perturb: %s already holds this analysis (theta %g, p = %llu)\n",
-                     bundle_path.c_str(), s.theta, static_cast<unsigned long long>(s.perturbations));
+        std::fprintf(
+            stderr, "lazyboe-perturb: %s already holds this analysis (theta %g, p = %llu)\n",
+            bundle_path.c_str(), s.theta, static_cast<unsigned long long>(s.perturbations));
         print_perturbation_summary(bundle, stdout);
       }
       write_bundle(bundle_path, bundle);  // p may have been raised to an equal value: keep in sync
@@ -86,9 +94,13 @@ int main(int argc, char** argv) {
     const PerturbOutcome outcome = run_perturbation(sim, bundle, s, control);
     if (!control.quiet) print_perturbation_summary(bundle, stdout);
     if (outcome == PerturbOutcome::Interrupted) {
-      std::fprintf(stderr, "lazyboe-perturb: interrupted; the completed edges are saved in %s. Continue with: lazyboe-perturb --bundle %s --theta %.17g --perturbations %llu --seed %llu\n",
-                   bundle_path.c_str(), bundle_path.c_str(), s.theta,
-                   static_cast<unsigned long long>(s.perturbations), static_cast<unsigned long long>(s.seed));
+      std::fprintf(
+          stderr,
+          "lazyboe-perturb: interrupted; the completed edges are saved in %s. Continue with: "
+          "lazyboe-perturb --bundle %s --theta %.17g --perturbations %llu --seed %llu\n",
+          bundle_path.c_str(), bundle_path.c_str(), s.theta,
+          static_cast<unsigned long long>(s.perturbations),
+          static_cast<unsigned long long>(s.seed));
       return 130;
     }
     return 0;

@@ -53,14 +53,23 @@ int main(int argc, char** argv) {
   int jobs = 1;
   double sample_interval = 0.01;
   bool no_mmap = false, quiet = false;
-  app.add_option("--bundle", bundle_path, "Bundle file (HDF5), with its perturbation analysis for lazyboe")->required();
-  app.add_option("--queries", queries_path, "Queries, one JSON object per line; - for standard input")->required();
-  app.add_option("--out", out_path, "Results, one JSON object per line; - for standard output")->capture_default_str();
-  app.add_option("--jobs", jobs, "Queries planned in parallel")->capture_default_str()->check(whole_number(false));
-  app.add_option("--trajectories", trajectories, "none, inline (in each result) or csv (files in --trajectory-dir)")
+  app.add_option("--bundle", bundle_path,
+                 "Bundle file (HDF5), with its perturbation analysis for lazyboe")
+      ->required();
+  app.add_option("--queries", queries_path,
+                 "Queries, one JSON object per line; - for standard input")
+      ->required();
+  app.add_option("--out", out_path, "Results, one JSON object per line; - for standard output")
+      ->capture_default_str();
+  app.add_option("--jobs", jobs, "Queries planned in parallel")
+      ->capture_default_str()
+      ->check(whole_number(false));
+  app.add_option("--trajectories", trajectories,
+                 "none, inline (in each result) or csv (files in --trajectory-dir)")
       ->capture_default_str();
   app.add_option("--trajectory-dir", trajectory_dir, "Directory for --trajectories csv");
-  app.add_option("--sample-interval", sample_interval, "Trajectory sample spacing, s")->capture_default_str();
+  app.add_option("--sample-interval", sample_interval, "Trajectory sample spacing, s")
+      ->capture_default_str();
   app.add_option("--robot", robot_path, "Robot config (default: the bundle's)");
   app.add_option("--env", env_path, "Environment (default: the bundle's)");
   app.add_flag("--no-mmap", no_mmap, "Read the bundle into memory instead of mapping it");
@@ -101,8 +110,10 @@ int main(int argc, char** argv) {
     const EdgeStartIndex index(bundle);
     const double load_seconds = std::chrono::duration<double>(Clock::now() - t0).count();
     if (!quiet) {
-      for (const std::string& w : bundle.warnings()) std::fprintf(stderr, "lazyboe-query: warning: %s\n", w.c_str());
-      std::fprintf(stderr, "lazyboe-query: %s: %zu edges loaded in %.3f s (%s), resident memory %.0f MiB\n",
+      for (const std::string& w : bundle.warnings())
+        std::fprintf(stderr, "lazyboe-query: warning: %s\n", w.c_str());
+      std::fprintf(stderr,
+                   "lazyboe-query: %s: %zu edges loaded in %.3f s (%s), resident memory %.0f MiB\n",
                    bundle_path.c_str(), bundle.size(), load_seconds,
                    bundle.memory_mapped() ? "memory-mapped" : "read into memory", resident_mib());
     }
@@ -117,7 +128,8 @@ int main(int argc, char** argv) {
     defaults.params.command.velocity_scale = h.velocity_scale;
     defaults.params.command.limit_scale = h.limit_scale;
     const PlanningContext context{sim, &bundle, &index};
-    const int sample_every = std::max(1, static_cast<int>(std::lround(sample_interval * robot.control_rate)));
+    const int sample_every =
+        std::max(1, static_cast<int>(std::lround(sample_interval * robot.control_rate)));
 
     // Output: a file written under a temporary name (renamed at the end), or standard output.
     const bool to_stdout = out_path == "-";
@@ -202,11 +214,13 @@ int main(int argc, char** argv) {
       std::map<std::string, std::vector<const Outcome*>> by_planner;
       size_t errors = 0;
       for (const Outcome& o : outcomes) {
-        if (o.error) ++errors;
-        else by_planner[o.planner].push_back(&o);
+        if (o.error)
+          ++errors;
+        else
+          by_planner[o.planner].push_back(&o);
       }
-      std::fprintf(stderr, "%-8s %7s %8s %14s %14s %10s\n", "planner", "queries", "success", "median TTFS s",
-                   "mean TTFS s", "mean cost");
+      std::fprintf(stderr, "%-8s %7s %8s %14s %14s %10s\n", "planner", "queries", "success",
+                   "median TTFS s", "mean TTFS s", "mean cost");
       for (const auto& [name, list] : by_planner) {
         std::vector<double> ttfs, cost;
         for (const Outcome* o : list) {
@@ -218,7 +232,8 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "%-8s %7zu %7.0f%% %14.4f %14.4f %10.3f\n", name.c_str(), list.size(),
                      100.0 * ttfs.size() / list.size(), qt.median, qt.mean, qc.mean);
       }
-      if (errors) std::fprintf(stderr, "%zu queries had errors (see their \"error\" field)\n", errors);
+      if (errors)
+        std::fprintf(stderr, "%zu queries had errors (see their \"error\" field)\n", errors);
       std::fprintf(stderr, "resident memory %.0f MiB\n", resident_mib());
     }
     return 0;

@@ -26,7 +26,8 @@ JointVector parse_q(const std::string& text, const RobotModel& robot) {
     start = comma + 1;
     char* end = nullptr;
     const double v = std::strtod(cell.c_str(), &end);
-    if (cell.empty() || end == cell.c_str() || *end != '\0') fail("--q", "not a number: '" + cell + "'");
+    if (cell.empty() || end == cell.c_str() || *end != '\0')
+      fail("--q", "not a number: '" + cell + "'");
     if (!std::isfinite(v)) fail("--q", "values must be finite");
     values.push_back(v);
   }
@@ -37,14 +38,21 @@ JointVector parse_q(const std::string& text, const RobotModel& robot) {
   return Eigen::Map<const Eigen::VectorXd>(values.data(), robot.dof);
 }
 
-json vec_json(const Eigen::VectorXd& v) { return std::vector<double>(v.data(), v.data() + v.size()); }
+json vec_json(const Eigen::VectorXd& v) {
+  return std::vector<double>(v.data(), v.data() + v.size());
+}
 
 json friction_json(const Friction& f) {
   switch (f.model) {
-    case FrictionModel::None: return {{"model", "none"}};
-    case FrictionModel::Sigmoid: return {{"model", "sigmoid"}, {"fi1", f.a}, {"fi2", f.b}, {"fi3", f.c}};
+    case FrictionModel::None:
+      return {{"model", "none"}};
+    case FrictionModel::Sigmoid:
+      return {{"model", "sigmoid"}, {"fi1", f.a}, {"fi2", f.b}, {"fi3", f.c}};
     case FrictionModel::ViscousCoulomb:
-      return {{"model", "viscous_coulomb"}, {"coulomb", f.a}, {"viscous", f.b}, {"smoothing_velocity", f.c}};
+      return {{"model", "viscous_coulomb"},
+              {"coulomb", f.a},
+              {"viscous", f.b},
+              {"smoothing_velocity", f.c}};
   }
   return {};
 }
@@ -52,10 +60,18 @@ json friction_json(const Friction& f) {
 std::string shape_text(const Shape& s) {
   char buf[128];
   switch (s.type) {
-    case ShapeType::Sphere: std::snprintf(buf, sizeof buf, "sphere r=%.4g", s.radius); break;
-    case ShapeType::Capsule: std::snprintf(buf, sizeof buf, "capsule r=%.4g l=%.4g", s.radius, s.length); break;
-    case ShapeType::Cylinder: std::snprintf(buf, sizeof buf, "cylinder r=%.4g l=%.4g", s.radius, s.length); break;
-    case ShapeType::Box: std::snprintf(buf, sizeof buf, "box %.4gx%.4gx%.4g", s.size.x(), s.size.y(), s.size.z()); break;
+    case ShapeType::Sphere:
+      std::snprintf(buf, sizeof buf, "sphere r=%.4g", s.radius);
+      break;
+    case ShapeType::Capsule:
+      std::snprintf(buf, sizeof buf, "capsule r=%.4g l=%.4g", s.radius, s.length);
+      break;
+    case ShapeType::Cylinder:
+      std::snprintf(buf, sizeof buf, "cylinder r=%.4g l=%.4g", s.radius, s.length);
+      break;
+    case ShapeType::Box:
+      std::snprintf(buf, sizeof buf, "box %.4gx%.4gx%.4g", s.size.x(), s.size.y(), s.size.z());
+      break;
   }
   return buf;
 }
@@ -73,21 +89,27 @@ int cmd_info(const RobotModel& robot, bool as_json) {
     for (const Joint& jt : robot.joints) {
       j["joints"].push_back({{"name", jt.name},
                              {"type", jt.type == JointType::Revolute ? "revolute" : "prismatic"},
-                             {"lower", jt.lower}, {"upper", jt.upper},
-                             {"max_velocity", jt.max_velocity}, {"max_acceleration", jt.max_acceleration},
-                             {"max_jerk", jt.max_jerk}, {"max_effort", jt.max_effort},
-                             {"max_torque_rate", jt.max_torque_rate}, {"friction", friction_json(jt.friction)}});
+                             {"lower", jt.lower},
+                             {"upper", jt.upper},
+                             {"max_velocity", jt.max_velocity},
+                             {"max_acceleration", jt.max_acceleration},
+                             {"max_jerk", jt.max_jerk},
+                             {"max_effort", jt.max_effort},
+                             {"max_torque_rate", jt.max_torque_rate},
+                             {"friction", friction_json(jt.friction)}});
     }
     for (size_t b = 0; b < robot.bodies.size(); ++b) {
-      j["bodies"].push_back({{"joint", robot.joints[b].name}, {"mass", robot.bodies[b].mass},
+      j["bodies"].push_back({{"joint", robot.joints[b].name},
+                             {"mass", robot.bodies[b].mass},
                              {"com", vec_json(robot.bodies[b].com)}});
     }
     for (const Link& l : robot.links) {
-      j["links"].push_back({{"name", l.name}, {"moved_by", l.body < 0 ? "base" : robot.joints[l.body].name}});
+      j["links"].push_back(
+          {{"name", l.name}, {"moved_by", l.body < 0 ? "base" : robot.joints[l.body].name}});
     }
     for (const CollisionBody& c : robot.collision_bodies) {
-      j["collision_bodies"].push_back({{"name", c.name}, {"link", robot.links[c.link].name},
-                                       {"shape", shape_text(c.shape)}});
+      j["collision_bodies"].push_back(
+          {{"name", c.name}, {"link", robot.links[c.link].name}, {"shape", shape_text(c.shape)}});
     }
     j["collision_margin"] = robot.collision_margin;
     for (const auto& [a, b] : robot.allowed_pairs) {
@@ -114,7 +136,8 @@ int cmd_info(const RobotModel& robot, bool as_json) {
   for (const Link& l : robot.links) {
     const bool owner = l.body >= 0 && robot.links[robot.link_index(l.name)].in_body.p.isZero() &&
                        robot.links[robot.link_index(l.name)].in_body.R.isIdentity();
-    std::printf("%-14s %-14s", l.name.c_str(), l.body < 0 ? "base" : robot.joints[l.body].name.c_str());
+    std::printf("%-14s %-14s", l.name.c_str(),
+                l.body < 0 ? "base" : robot.joints[l.body].name.c_str());
     if (owner) std::printf(" %9.4f", robot.bodies[l.body].mass);
     std::printf("\n");
   }
@@ -160,8 +183,8 @@ int cmd_torques(const RobotModel& robot, const std::string& in, const std::strin
   std::vector<double> row(n);
   for (const std::vector<double>& r : table.rows) {
     Eigen::Map<const Eigen::VectorXd> all(r.data(), 3 * n);
-    const JointVector& tau = inverse_dynamics(robot, data, all.segment(0, n), all.segment(n, n),
-                                              all.segment(2 * n, n));
+    const JointVector& tau =
+        inverse_dynamics(robot, data, all.segment(0, n), all.segment(n, n), all.segment(2 * n, n));
     for (int i = 0; i < n; ++i) row[i] = tau[i];
     writer.row(row);
   }
@@ -206,7 +229,8 @@ int cmd_allowed_pairs(const RobotModel& robot, long samples, uint64_t seed) {
     std::fprintf(stderr, "%-14s %-14s %9.2f%%  %s\n", robot.links[p.link_a].name.c_str(),
                  robot.links[p.link_b].name.c_str(), 100.0 * p.collisions / samples,
                  p.reason.empty() ? "-" : p.reason.c_str());
-    if (!p.reason.empty()) pairs.push_back({robot.links[p.link_a].name, robot.links[p.link_b].name});
+    if (!p.reason.empty())
+      pairs.push_back({robot.links[p.link_a].name, robot.links[p.link_b].name});
   }
   std::cout << json{{"allowed_pairs", pairs}}.dump() << "\n";
   return 0;
@@ -218,7 +242,8 @@ int main(int argc, char** argv) {
   CLI::App app{"Inspect a robot description: joints, kinematics, dynamics, collision."};
   app.require_subcommand(1);
   std::string robot_path = lazyboe::default_robot_path();
-  app.add_option("--robot", robot_path, "Robot config (JSON) naming its URDF")->capture_default_str();
+  app.add_option("--robot", robot_path, "Robot config (JSON) naming its URDF")
+      ->capture_default_str();
 
   auto* info = app.add_subcommand("info", "Joints, limits, links and collision bodies");
   bool info_json = false;
@@ -238,12 +263,13 @@ int main(int argc, char** argv) {
   std::string env_path = lazyboe::default_environment_path();
   check->add_option("--env", env_path, "Environment (JSON)")->capture_default_str();
   check->add_option("--in", in_path, "CSV with header q1..qn")->required();
-  check->add_option("--out", out_path,
-                    "CSV written with in_limits,self_collision,env_collision,min_distance")
+  check
+      ->add_option("--out", out_path,
+                   "CSV written with in_limits,self_collision,env_collision,min_distance")
       ->required();
 
-  auto* pairs = app.add_subcommand("allowed-pairs",
-                                   "Derive the allowed-collision link pairs by sampling");
+  auto* pairs =
+      app.add_subcommand("allowed-pairs", "Derive the allowed-collision link pairs by sampling");
   long samples = 100000;
   uint64_t seed = 1;
   pairs->add_option("--samples", samples, "Random configurations to test")->capture_default_str();

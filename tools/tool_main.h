@@ -2,15 +2,15 @@
 // exit status 1; command-line mistakes are reported by CLI11 (exit status 2 or more).
 #pragma once
 
-#include <CLI/CLI.hpp>
 #include <unistd.h>
 
+#include <CLI/CLI.hpp>
 #include <atomic>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <ctime>
 #include <exception>
-#include <cstdlib>
 #include <string>
 
 #include "common/error.h"
@@ -28,8 +28,10 @@ inline void one_line_cli_errors(CLI::App& app, const std::string& tool) {
 inline CLI::Validator whole_number(bool allow_zero) {
   return CLI::Validator(
       [allow_zero](std::string& text) -> std::string {
-        const bool digits = !text.empty() && text.find_first_not_of("0123456789") == std::string::npos;
-        if (!digits || text.size() > 19) return allow_zero ? "must be a whole number >= 0" : "must be a whole number > 0";
+        const bool digits =
+            !text.empty() && text.find_first_not_of("0123456789") == std::string::npos;
+        if (!digits || text.size() > 19)
+          return allow_zero ? "must be a whole number >= 0" : "must be a whole number > 0";
         if (!allow_zero && std::stoull(text) == 0) return "must be a whole number > 0";
         return "";
       },

@@ -25,7 +25,9 @@ const char* integrator_name(Integrator integrator) {
   return integrator == Integrator::RK4 ? "rk4" : "euler";
 }
 
-std::vector<double> to_std(const JointVector& v) { return std::vector<double>(v.data(), v.data() + v.size()); }
+std::vector<double> to_std(const JointVector& v) {
+  return std::vector<double>(v.data(), v.data() + v.size());
+}
 
 JointVector from_std(const std::vector<double>& v) {
   return Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size()));
@@ -154,7 +156,8 @@ void check_resume_compatible(const BundleHeader& have, const BundleHeader& want,
   if (have.robot_hash != want.robot_hash) {
     differs("robot (config or URDF content)", have.robot_config, want.robot_config);
   }
-  if (have.env_hash != want.env_hash) differs("environment (file content)", have.env_file, want.env_file);
+  if (have.env_hash != want.env_hash)
+    differs("environment (file content)", have.env_file, want.env_file);
   if (have.seed != want.seed) differs("--seed", num(have.seed), num(want.seed));
   if (have.region_lower != want.region_lower || have.region_upper != want.region_upper) {
     differs("--region", vec(have.region_lower) + " .. " + vec(have.region_upper),
@@ -182,7 +185,8 @@ void check_region(const Simulator& sim, const BuildSettings& settings) {
     if (!(settings.region_lower[i] < settings.region_upper[i])) {
       fail("--region", "joint " + std::to_string(i + 1) + ": lower bound must be below upper");
     }
-    if (settings.region_lower[i] < sim.robot.q_min[i] || settings.region_upper[i] > sim.robot.q_max[i]) {
+    if (settings.region_lower[i] < sim.robot.q_min[i] ||
+        settings.region_upper[i] > sim.robot.q_max[i]) {
       fail("--region", "joint " + std::to_string(i + 1) + " (" + sim.robot.joints[i].name +
                            "): outside the joint limits [" + std::to_string(sim.robot.q_min[i]) +
                            ", " + std::to_string(sim.robot.q_max[i]) + "]");
@@ -192,11 +196,13 @@ void check_region(const Simulator& sim, const BuildSettings& settings) {
   Random rng(settings.seed, ~0ULL);  // a stream no attempt uses
   JointVector q(n);
   for (int k = 0; k < 2000; ++k) {
-    for (int i = 0; i < n; ++i) q[i] = rng.uniform(settings.region_lower[i], settings.region_upper[i]);
+    for (int i = 0; i < n; ++i)
+      q[i] = rng.uniform(settings.region_lower[i], settings.region_upper[i]);
     if (check_state(sim, ws, q) == RolloutStatus::Valid) return;
   }
-  fail("--region", "no collision-free start state found in 2000 samples: the region is (almost) "
-                   "entirely in collision in this environment");
+  fail("--region",
+       "no collision-free start state found in 2000 samples: the region is (almost) "
+       "entirely in collision in this environment");
 }
 
 BuildOutcome build_bundle(const Simulator& sim, const BuildSettings& settings, Bundle& bundle,

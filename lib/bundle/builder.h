@@ -26,10 +26,10 @@ struct BuildSettings {
 
 // How the build runs, not what it makes.
 struct BuildControl {
-  int threads = 0;                  // 0: all available
-  double checkpoint_seconds = 10;   // at least this long between checkpoints
+  int threads = 0;                 // 0: all available
+  double checkpoint_seconds = 10;  // at least this long between checkpoints
   bool quiet = false;
-  std::function<bool()> stop_requested;               // polled between rounds
+  std::function<bool()> stop_requested;                // polled between rounds
   std::function<void(const Bundle&)> save_checkpoint;  // persists the bundle so far
 };
 

@@ -66,14 +66,14 @@ struct Bundle {
   BundleHeader header;
   Perturbation perturbation;  // empty until lazyboe-perturb runs
   // Per edge (N edges), row-major with dof columns where two-dimensional.
-  std::vector<double> q0, qf;             // N x dof: start and end state (at rest)
-  std::vector<double> duration;           // N: simulated duration including settling, s
-  std::vector<double> command_duration;   // N: duration of the velocity command, s
-  std::vector<uint64_t> attempt;          // N: attempt index (edge = f(seed, attempt))
-  std::vector<uint64_t> knot_offset;      // N + 1: rows of `knots` of edge k: [off[k], off[k+1])
-  std::vector<double> knots;              // K x dof: velocity knots, rad/s
-  std::vector<uint64_t> sample_offset;    // N + 1: rows of the trajectory samples of edge k
-  std::vector<float> sample_q, sample_dq; // S x dof: states every sample_interval, and the end
+  std::vector<double> q0, qf;              // N x dof: start and end state (at rest)
+  std::vector<double> duration;            // N: simulated duration including settling, s
+  std::vector<double> command_duration;    // N: duration of the velocity command, s
+  std::vector<uint64_t> attempt;           // N: attempt index (edge = f(seed, attempt))
+  std::vector<uint64_t> knot_offset;       // N + 1: rows of `knots` of edge k: [off[k], off[k+1])
+  std::vector<double> knots;               // K x dof: velocity knots, rad/s
+  std::vector<uint64_t> sample_offset;     // N + 1: rows of the trajectory samples of edge k
+  std::vector<float> sample_q, sample_dq;  // S x dof: states every sample_interval, and the end
 
   size_t size() const { return duration.size(); }
   int dof() const { return header.dof; }

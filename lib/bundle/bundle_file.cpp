@@ -22,7 +22,8 @@ std::string str(uint64_t v) { return std::to_string(v); }
 
 // `name` is "bundle.knot_offset" for memory, "/edges/knot_offset" for the file.
 void check_offsets(const std::string& where, const std::string& name,
-                   const std::vector<uint64_t>& offsets, uint64_t rows, const std::string& rows_name) {
+                   const std::vector<uint64_t>& offsets, uint64_t rows,
+                   const std::string& rows_name) {
   if (offsets.empty()) return;  // sizes are checked by the caller
   if (offsets[0] != 0) fail(where, name + ": first value " + str(offsets[0]) + ", expected 0");
   for (size_t k = 0; k + 1 < offsets.size(); ++k)
@@ -38,18 +39,18 @@ void check_header(const std::string& where, const std::string& prefix, const Bun
   if (h.dof < 1) fail(where, prefix + "dof: " + std::to_string(h.dof) + ", expected at least 1");
   const size_t dof = static_cast<size_t>(h.dof);
   if (h.region_lower.size() != dof)
-    fail(where, prefix + "region_lower: " + str(h.region_lower.size()) + " values, expected dof = " +
-                    str(dof));
+    fail(where, prefix + "region_lower: " + str(h.region_lower.size()) +
+                    " values, expected dof = " + str(dof));
   if (h.region_upper.size() != dof)
-    fail(where, prefix + "region_upper: " + str(h.region_upper.size()) + " values, expected dof = " +
-                    str(dof));
+    fail(where, prefix + "region_upper: " + str(h.region_upper.size()) +
+                    " values, expected dof = " + str(dof));
 }
 
 void check_size(const std::string& where, const std::string& field, size_t found, size_t expected,
                 const std::string& expected_text) {
   if (found != expected)
-    fail(where, "bundle." + field + ": " + str(found) + " values, expected " + expected_text + " = " +
-                    str(expected));
+    fail(where, "bundle." + field + ": " + str(found) + " values, expected " + expected_text +
+                    " = " + str(expected));
 }
 
 // ---- header <-> root attributes ----
@@ -137,8 +138,8 @@ BundleHeader read_header(const std::string& where, hid_t file, uint64_t* edges) 
   const std::vector<std::string> reasons = read_attr_strings(where, file, "rejected_reasons");
   const std::vector<uint64_t> counts = read_attr_u64s(where, file, "rejected_counts");
   if (reasons.size() != counts.size())
-    fail(where, "attribute rejected_counts: " + str(counts.size()) + " values, but rejected_reasons has " +
-                    str(reasons.size()));
+    fail(where, "attribute rejected_counts: " + str(counts.size()) +
+                    " values, but rejected_reasons has " + str(reasons.size()));
   for (size_t i = 0; i < reasons.size(); ++i)
     if (!h.rejected.emplace(reasons[i], counts[i]).second)
       fail(where, "attribute rejected_reasons: reason '" + reasons[i] + "' appears twice");
@@ -198,10 +199,11 @@ void check_bundle(const Bundle& b, const std::string& where) {
   check_size(where, "knot_offset", b.knot_offset.size(), n + 1, "edges + 1");
   check_size(where, "sample_offset", b.sample_offset.size(), n + 1, "edges + 1");
   if (b.knots.size() % dof != 0)
-    fail(where, "bundle.knots: " + str(b.knots.size()) + " values, not a multiple of dof = " + str(dof));
+    fail(where,
+         "bundle.knots: " + str(b.knots.size()) + " values, not a multiple of dof = " + str(dof));
   if (b.sample_q.size() % dof != 0)
-    fail(where, "bundle.sample_q: " + str(b.sample_q.size()) + " values, not a multiple of dof = " +
-                    str(dof));
+    fail(where, "bundle.sample_q: " + str(b.sample_q.size()) +
+                    " values, not a multiple of dof = " + str(dof));
   check_size(where, "sample_dq", b.sample_dq.size(), b.sample_q.size(), "sample_q.size()");
   if (b.perturbation.present) {
     const Perturbation& p = b.perturbation;
@@ -250,8 +252,9 @@ void write_bundle(const std::string& path, const Bundle& b) {
         h5::write_attr_u64(tmp, g, "seed", p.seed);
         h5::write_attr_f64(tmp, g, "wall_seconds", p.wall_seconds);
         h5::write_attr_f64(tmp, g, "simulated_seconds", p.simulated_seconds);
-        h5::write_attr_string(tmp, g, "distribution",
-                              "start + d, d = r u: u uniform on the unit sphere, r uniform in (0, theta]");
+        h5::write_attr_string(
+            tmp, g, "distribution",
+            "start + d, d = r u: u uniform on the unit sphere, r uniform in (0, theta]");
         h5::write_dataset(tmp, file, ds::pert_done, p.done, {n});
         h5::write_dataset(tmp, file, ds::pert_valid, p.valid, {n});
         h5::write_dataset(tmp, file, ds::pert_lazy, p.lazy, {n});

@@ -55,11 +55,12 @@ CommandProfile BundleView::command(size_t e) const {
 }
 
 template <typename T>
-const T* BundleView::attach(long file, const std::string& dataset, const std::vector<uint64_t>& dims,
-                            bool allow_mmap) {
+const T* BundleView::attach(long file, const std::string& dataset,
+                            const std::vector<uint64_t>& dims, bool allow_mmap) {
   const std::vector<uint64_t> shape = h5::dataset_shape(path_, file, dataset);
   if (shape != dims) {
-    fail(path_, dataset + ": shape " + h5::shape_string(shape) + ", expected " + h5::shape_string(dims));
+    fail(path_,
+         dataset + ": shape " + h5::shape_string(shape) + ", expected " + h5::shape_string(dims));
   }
   uint64_t count = 1;
   for (uint64_t d : dims) count *= d;
@@ -70,7 +71,8 @@ const T* BundleView::attach(long file, const std::string& dataset, const std::ve
         loc.file_offset + loc.bytes <= map_bytes_) {
       return reinterpret_cast<const T*>(static_cast<const char*>(map_) + loc.file_offset);
     }
-    warnings_.push_back(dataset + " cannot be memory-mapped (chunked, compressed or unaligned): read into memory");
+    warnings_.push_back(
+        dataset + " cannot be memory-mapped (chunked, compressed or unaligned): read into memory");
   }
   all_mapped_ = false;
   auto data = std::make_shared<std::vector<T>>(h5::read_dataset<T>(path_, file, dataset, dims));
@@ -110,12 +112,14 @@ BundleView BundleView::open(const std::string& path, bool allow_mmap) {
   v.command_duration_ = v.attach<double>(file, ds::command_duration, {n}, allow_mmap);
   v.knot_offset_ = v.attach<uint64_t>(file, ds::knot_offset, {n + 1}, allow_mmap);
   const std::vector<uint64_t> knot_shape = h5::dataset_shape(path, file, ds::knots);
-  if (knot_shape.size() != 2 || knot_shape[1] != dof) fail(path, std::string(ds::knots) + ": expected K x dof");
+  if (knot_shape.size() != 2 || knot_shape[1] != dof)
+    fail(path, std::string(ds::knots) + ": expected K x dof");
   v.knots_ = v.attach<double>(file, ds::knots, knot_shape, allow_mmap);
   // The offsets index the knots: check them once so that no query can read out of bounds.
   for (uint64_t e = 0; e < n; ++e) {
     if (v.knot_offset_[e + 1] < v.knot_offset_[e] + 2 || v.knot_offset_[e + 1] > knot_shape[0]) {
-      fail(path, std::string(ds::knot_offset) + ": edge " + std::to_string(e) + " has a bad knot range");
+      fail(path,
+           std::string(ds::knot_offset) + ": edge " + std::to_string(e) + " has a bad knot range");
     }
   }
   if (h5::exists(file, ds::perturbation)) {
@@ -127,7 +131,8 @@ BundleView BundleView::open(const std::string& path, bool allow_mmap) {
       v.p_lazy_prop_ = v.attach<double>(file, ds::p_lazy_prop, {n}, allow_mmap);
       v.p_collision_ = v.attach<double>(file, ds::p_collision, {n}, allow_mmap);
     } else {
-      v.warnings_.push_back("the perturbation analysis is incomplete (finish it with lazyboe-perturb): not used");
+      v.warnings_.push_back(
+          "the perturbation analysis is incomplete (finish it with lazyboe-perturb): not used");
     }
   }
   return v;

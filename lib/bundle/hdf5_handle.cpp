@@ -51,15 +51,22 @@ std::string type_string(hid_t type) {
   const H5T_class_t cls = H5Tget_class(type);
   const size_t bits = H5Tget_size(type) * 8;
   switch (cls) {
-    case H5T_FLOAT: return "float" + std::to_string(bits);
+    case H5T_FLOAT:
+      return "float" + std::to_string(bits);
     case H5T_INTEGER:
       return (H5Tget_sign(type) == H5T_SGN_NONE ? "uint" : "int") + std::to_string(bits);
-    case H5T_STRING: return "string";
-    case H5T_COMPOUND: return "compound";
-    case H5T_ARRAY: return "array";
-    case H5T_VLEN: return "variable-length sequence";
-    case H5T_ENUM: return "enum";
-    default: return "unsupported type";
+    case H5T_STRING:
+      return "string";
+    case H5T_COMPOUND:
+      return "compound";
+    case H5T_ARRAY:
+      return "array";
+    case H5T_VLEN:
+      return "variable-length sequence";
+    case H5T_ENUM:
+      return "enum";
+    default:
+      return "unsupported type";
   }
 }
 
@@ -85,13 +92,15 @@ void write_attr_raw(const std::string& where, hid_t obj, const std::string& name
                     hid_t mem_type, const std::vector<hsize_t>& dims, const void* data) {
   if (has_attribute(obj, name) && H5Adelete(obj, name.c_str()) < 0)
     fail_hdf5(where, attr_where(name) + ": cannot replace");
-  Dataspace space(dims.empty() ? H5Screate(H5S_SCALAR)
-                               : H5Screate_simple(static_cast<int>(dims.size()), dims.data(), nullptr));
+  Dataspace space(dims.empty()
+                      ? H5Screate(H5S_SCALAR)
+                      : H5Screate_simple(static_cast<int>(dims.size()), dims.data(), nullptr));
   if (!space.valid()) fail_hdf5(where, attr_where(name) + ": cannot create its dataspace");
   Attribute attr(H5Acreate2(obj, name.c_str(), file_type, space, H5P_DEFAULT, H5P_DEFAULT));
   if (!attr.valid()) fail_hdf5(where, attr_where(name) + ": cannot create");
   const bool empty = !dims.empty() && dims[0] == 0;
-  if (!empty && H5Awrite(attr, mem_type, data) < 0) fail_hdf5(where, attr_where(name) + ": cannot write");
+  if (!empty && H5Awrite(attr, mem_type, data) < 0)
+    fail_hdf5(where, attr_where(name) + ": cannot write");
   if (attr.close() < 0) fail_hdf5(where, attr_where(name) + ": cannot close");
 }
 
@@ -125,8 +134,9 @@ OpenAttr open_attr(const std::string& where, hid_t obj, const std::string& name,
     H5Sget_simple_extent_dims(space, &n, nullptr);
     a.count = n;
   } else {
-    fail(where, attr_where(name) + ": expected " + (want_vector ? "a 1-D array" : "a single value") +
-                    ", found rank " + std::to_string(rank));
+    fail(where, attr_where(name) + ": expected " +
+                    (want_vector ? "a 1-D array" : "a single value") + ", found rank " +
+                    std::to_string(rank));
   }
   if (want_vector && a.scalar)
     fail(where, attr_where(name) + ": expected a 1-D array, found a single value");
@@ -155,7 +165,8 @@ struct IntValues {
   std::vector<uint64_t> u;
 };
 
-IntValues read_ints(const std::string& where, hid_t obj, const std::string& name, bool want_vector) {
+IntValues read_ints(const std::string& where, hid_t obj, const std::string& name,
+                    bool want_vector) {
   OpenAttr a = open_attr(where, obj, name, want_vector);
   require_class(where, name, a, H5T_INTEGER, "an integer");
   IntValues v;
@@ -235,7 +246,8 @@ namespace {
 File open_file_mode(const std::string& path, unsigned flags) {
   quiet();
   struct stat st;
-  if (::stat(path.c_str(), &st) != 0) fail(path, "cannot open: " + std::string(std::strerror(errno)));
+  if (::stat(path.c_str(), &st) != 0)
+    fail(path, "cannot open: " + std::string(std::strerror(errno)));
   if (S_ISDIR(st.st_mode)) fail(path, "cannot open: is a directory");
   const int fd = ::open(path.c_str(), (flags & H5F_ACC_RDWR) ? O_RDWR : O_RDONLY);
   if (fd < 0) fail(path, "cannot open: " + std::string(std::strerror(errno)));
@@ -297,7 +309,8 @@ template <class T>
 void write_dataset(const std::string& where, hid_t loc, const std::string& name,
                    const std::vector<T>& data, const std::vector<uint64_t>& dims) {
   quiet();
-  if (dims.empty() || dims.size() > 2) fail(where, name + ": only 1-D and 2-D datasets are written");
+  if (dims.empty() || dims.size() > 2)
+    fail(where, name + ": only 1-D and 2-D datasets are written");
   uint64_t count = 1;
   for (uint64_t d : dims) count *= d;
   if (count != data.size())
@@ -310,9 +323,11 @@ void write_dataset(const std::string& where, hid_t loc, const std::string& name,
   if (H5Pset_layout(dcpl, H5D_CONTIGUOUS) < 0 || H5Pset_obj_track_times(dcpl, 0) < 0 ||
       H5Pset_fill_time(dcpl, H5D_FILL_TIME_NEVER) < 0)
     fail_hdf5(where, name + ": cannot set up the dataset");
-  Dataset dset(H5Dcreate2(loc, name.c_str(), TypeOf<T>::file(), space, H5P_DEFAULT, dcpl, H5P_DEFAULT));
+  Dataset dset(
+      H5Dcreate2(loc, name.c_str(), TypeOf<T>::file(), space, H5P_DEFAULT, dcpl, H5P_DEFAULT));
   if (!dset.valid()) fail_hdf5(where, name + ": cannot create the dataset");
-  if (count > 0 && H5Dwrite(dset, TypeOf<T>::memory(), H5S_ALL, H5S_ALL, H5P_DEFAULT, data.data()) < 0)
+  if (count > 0 &&
+      H5Dwrite(dset, TypeOf<T>::memory(), H5S_ALL, H5S_ALL, H5P_DEFAULT, data.data()) < 0)
     fail_hdf5(where, name + ": cannot write");
   if (dset.close() < 0) fail_hdf5(where, name + ": cannot close");
 }
@@ -352,7 +367,8 @@ std::vector<T> read_dataset(const std::string& where, hid_t loc, const std::stri
   uint64_t count = 1;
   for (uint64_t d : dims) count *= d;
   std::vector<T> data(count);
-  if (count > 0 && H5Dread(dset, TypeOf<T>::memory(), H5S_ALL, H5S_ALL, H5P_DEFAULT, data.data()) < 0)
+  if (count > 0 &&
+      H5Dread(dset, TypeOf<T>::memory(), H5S_ALL, H5S_ALL, H5P_DEFAULT, data.data()) < 0)
     fail_hdf5(where, name + ": cannot read");
   return data;
 }
@@ -404,12 +420,14 @@ void write_attr_string(const std::string& where, hid_t obj, const std::string& n
 
 void write_attr_f64s(const std::string& where, hid_t obj, const std::string& name,
                      const std::vector<double>& values) {
-  write_attr_raw(where, obj, name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, {values.size()}, values.data());
+  write_attr_raw(where, obj, name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, {values.size()},
+                 values.data());
 }
 
 void write_attr_u64s(const std::string& where, hid_t obj, const std::string& name,
                      const std::vector<uint64_t>& values) {
-  write_attr_raw(where, obj, name, H5T_STD_U64LE, H5T_NATIVE_UINT64, {values.size()}, values.data());
+  write_attr_raw(where, obj, name, H5T_STD_U64LE, H5T_NATIVE_UINT64, {values.size()},
+                 values.data());
 }
 
 void write_attr_strings(const std::string& where, hid_t obj, const std::string& name,
@@ -448,7 +466,8 @@ double read_attr_f64(const std::string& where, hid_t obj, const std::string& nam
 
 bool read_attr_bool(const std::string& where, hid_t obj, const std::string& name) {
   const int64_t v = read_attr_i64(where, obj, name);
-  if (v != 0 && v != 1) fail(where, attr_where(name) + ": expected 0 or 1, found " + std::to_string(v));
+  if (v != 0 && v != 1)
+    fail(where, attr_where(name) + ": expected 0 or 1, found " + std::to_string(v));
   return v == 1;
 }
 

@@ -129,7 +129,8 @@ bool has_attribute(hid_t obj, const std::string& name);
 void write_attr_i64(const std::string& where, hid_t obj, const std::string& name, int64_t value);
 void write_attr_u64(const std::string& where, hid_t obj, const std::string& name, uint64_t value);
 void write_attr_f64(const std::string& where, hid_t obj, const std::string& name, double value);
-void write_attr_bool(const std::string& where, hid_t obj, const std::string& name, bool value);  // uint8 0/1
+void write_attr_bool(const std::string& where, hid_t obj, const std::string& name,
+                     bool value);  // uint8 0/1
 // Variable-length UTF-8 strings (no embedded NUL).
 void write_attr_string(const std::string& where, hid_t obj, const std::string& name,
                        const std::string& value);

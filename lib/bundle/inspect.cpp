@@ -17,7 +17,8 @@ std::vector<double> neighbour_counts(const Bundle& b, double theta, int points, 
   std::vector<double> p(n);
   const double r2 = theta * theta;
   for (int k = 0; k < points; ++k) {
-    for (int i = 0; i < n; ++i) p[i] = rng.uniform(b.header.region_lower[i], b.header.region_upper[i]);
+    for (int i = 0; i < n; ++i)
+      p[i] = rng.uniform(b.header.region_lower[i], b.header.region_upper[i]);
     size_t c = 0;
     for (size_t e = 0; e < N; ++e) {
       double d2 = 0;
@@ -52,25 +53,34 @@ void print_perturbation_summary(const Bundle& b, std::FILE* out) {
     never += select[e] == 0;
     if (p.valid[e]) errors.push_back(p.max_error[e]);
   }
-  std::fprintf(out, "perturbation analysis: theta %g rad, %llu perturbations per edge, seed %llu, %s\n", p.theta,
-               static_cast<unsigned long long>(p.perturbations), static_cast<unsigned long long>(p.seed),
+  std::fprintf(out,
+               "perturbation analysis: theta %g rad, %llu perturbations per edge, seed %llu, %s\n",
+               p.theta, static_cast<unsigned long long>(p.perturbations),
+               static_cast<unsigned long long>(p.seed),
                p.complete ? "complete" : "INCOMPLETE (run lazyboe-perturb again to continue)");
-  std::fprintf(out, "  edges done %llu of %zu; rollouts %llu: valid %.1f%%, collided %.1f%%; simulated %.0f s in %.1f s wall\n",
+  std::fprintf(out,
+               "  edges done %llu of %zu; rollouts %llu: valid %.1f%%, collided %.1f%%; simulated "
+               "%.0f s in %.1f s wall\n",
                static_cast<unsigned long long>(finished), N, static_cast<unsigned long long>(done),
                done ? 100.0 * valid / done : 0.0, done ? 100.0 * collision / done : 0.0,
                p.simulated_seconds, p.wall_seconds);
   if (N == 0) return;
-  const Quantiles ql = quantiles(p.p_lazy_prop), qc = quantiles(p.p_collision), qs = quantiles(select);
+  const Quantiles ql = quantiles(p.p_lazy_prop), qc = quantiles(p.p_collision),
+                  qs = quantiles(select);
   std::fprintf(out, "P_lazy_prop: mean %.3f, median %.3f\n", ql.mean, ql.median);
   std::fputs(text_histogram(p.p_lazy_prop, 0, 1, 10).c_str(), out);
   std::fprintf(out, "P_collision: mean %.3f, median %.3f\n", qc.mean, qc.median);
   std::fputs(text_histogram(p.p_collision, 0, 1, 10).c_str(), out);
   if (!errors.empty()) {
     const Quantiles qe = quantiles(errors);
-    std::fprintf(out, "max end-state error per edge (rad): median %.3f, 90th percentile %.3f, max %.3f (theta/2 = %.3f)\n",
+    std::fprintf(out,
+                 "max end-state error per edge (rad): median %.3f, 90th percentile %.3f, max %.3f "
+                 "(theta/2 = %.3f)\n",
                  qe.median, qe.p90, qe.max, p.theta / 2);
   }
-  std::fprintf(out, "P_select = (1 - P_collision) P_lazy_prop: mean %.3f; %.1f%% of edges >= 0.5 (usable for lazy propagation), %.1f%% never taken lazily (0)\n",
+  std::fprintf(out,
+               "P_select = (1 - P_collision) P_lazy_prop: mean %.3f; %.1f%% of edges >= 0.5 "
+               "(usable for lazy propagation), %.1f%% never taken lazily (0)\n",
                qs.mean, 100.0 * usable / N, 100.0 * never / N);
 }
 
@@ -80,24 +90,32 @@ void print_inspection(const std::string& path, std::FILE* out) {
   const int n = b.dof();
   const size_t N = b.size();
   std::fprintf(out, "bundle %s\n", path.c_str());
-  std::fprintf(out, "  schema version %d, written by lazyboe %s, %s\n", h.schema_version,
-               h.tool_version.c_str(), h.complete ? "complete" : "INCOMPLETE (resume with lazyboe-build --resume --out FILE)");
-  std::fprintf(out, "  robot %s (%s, hash %s), %d joints\n", h.robot_name.c_str(), h.robot_config.c_str(),
-               h.robot_hash.c_str(), n);
-  std::fprintf(out, "  environment %s (%s, hash %s)\n", h.env_name.c_str(), h.env_file.c_str(), h.env_hash.c_str());
+  std::fprintf(
+      out, "  schema version %d, written by lazyboe %s, %s\n", h.schema_version,
+      h.tool_version.c_str(),
+      h.complete ? "complete" : "INCOMPLETE (resume with lazyboe-build --resume --out FILE)");
+  std::fprintf(out, "  robot %s (%s, hash %s), %d joints\n", h.robot_name.c_str(),
+               h.robot_config.c_str(), h.robot_hash.c_str(), n);
+  std::fprintf(out, "  environment %s (%s, hash %s)\n", h.env_name.c_str(), h.env_file.c_str(),
+               h.env_hash.c_str());
   std::fprintf(out, "  edges %zu of %llu, seed %llu, design theta %g rad\n", N,
-               static_cast<unsigned long long>(h.target_edges), static_cast<unsigned long long>(h.seed), h.design_theta);
-  std::fprintf(out, "  commands %g-%g s, knots every ~%g s, speed <= %g x limit, accel/jerk <= %g x limit\n",
-               h.min_duration, h.max_duration, h.knot_interval, h.velocity_scale, h.limit_scale);
-  std::fprintf(out, "  simulation %s x%d at %g Hz, trajectory samples every %g s\n", h.integrator.c_str(),
-               h.substeps, h.control_rate, h.sample_interval);
+               static_cast<unsigned long long>(h.target_edges),
+               static_cast<unsigned long long>(h.seed), h.design_theta);
+  std::fprintf(
+      out, "  commands %g-%g s, knots every ~%g s, speed <= %g x limit, accel/jerk <= %g x limit\n",
+      h.min_duration, h.max_duration, h.knot_interval, h.velocity_scale, h.limit_scale);
+  std::fprintf(out, "  simulation %s x%d at %g Hz, trajectory samples every %g s\n",
+               h.integrator.c_str(), h.substeps, h.control_rate, h.sample_interval);
   std::fprintf(out, "  region:");
   for (int i = 0; i < n; ++i) std::fprintf(out, " [%g, %g]", h.region_lower[i], h.region_upper[i]);
   std::fprintf(out, "\n  attempts %llu, valid %llu (%.1f%%), start states resampled %llu\n",
-               static_cast<unsigned long long>(h.attempts), static_cast<unsigned long long>(h.valid),
-               h.attempts ? 100.0 * h.valid / h.attempts : 0.0, static_cast<unsigned long long>(h.start_resamples));
+               static_cast<unsigned long long>(h.attempts),
+               static_cast<unsigned long long>(h.valid),
+               h.attempts ? 100.0 * h.valid / h.attempts : 0.0,
+               static_cast<unsigned long long>(h.start_resamples));
   for (const auto& [reason, count] : h.rejected) {
-    std::fprintf(out, "    rejected %-20s %llu\n", reason.c_str(), static_cast<unsigned long long>(count));
+    std::fprintf(out, "    rejected %-20s %llu\n", reason.c_str(),
+                 static_cast<unsigned long long>(count));
   }
   std::fprintf(out, "  simulated %.1f s, wall %.1f s\n", h.simulated_seconds, h.wall_seconds);
   if (N == 0) return;
@@ -109,16 +127,21 @@ void print_inspection(const std::string& path, std::FILE* out) {
     displacement[e] = std::sqrt(d2);
   }
   const Quantiles qd = quantiles(b.duration), qx = quantiles(displacement);
-  std::fprintf(out, "\nedge duration (s): mean %.3f, median %.3f, min %.3f, max %.3f\n", qd.mean, qd.median, qd.min, qd.max);
+  std::fprintf(out, "\nedge duration (s): mean %.3f, median %.3f, min %.3f, max %.3f\n", qd.mean,
+               qd.median, qd.min, qd.max);
   std::fputs(text_histogram(b.duration, qd.min, qd.max, 8).c_str(), out);
-  std::fprintf(out, "edge displacement |qf - q0| (rad): mean %.3f, median %.3f, max %.3f\n", qx.mean, qx.median, qx.max);
+  std::fprintf(out, "edge displacement |qf - q0| (rad): mean %.3f, median %.3f, max %.3f\n",
+               qx.mean, qx.median, qx.max);
   std::fputs(text_histogram(displacement, 0, qx.max, 8).c_str(), out);
 
-  std::fprintf(out, "coverage of the region by edge starts (share of edges per tenth of each joint's range):\n");
+  std::fprintf(
+      out,
+      "coverage of the region by edge starts (share of edges per tenth of each joint's range):\n");
   for (int i = 0; i < n; ++i) {
     int bins[10] = {0};
     for (size_t e = 0; e < N; ++e) {
-      const double f = (b.q0[e * n + i] - h.region_lower[i]) / (h.region_upper[i] - h.region_lower[i]);
+      const double f =
+          (b.q0[e * n + i] - h.region_lower[i]) / (h.region_upper[i] - h.region_lower[i]);
       bins[std::clamp(static_cast<int>(f * 10), 0, 9)]++;
     }
     std::fprintf(out, "  joint %d:", i + 1);
@@ -129,8 +152,9 @@ void print_inspection(const std::string& path, std::FILE* out) {
   const Quantiles qn = quantiles(counts);
   size_t zero = 0;
   for (double c : counts) zero += c == 0;
-  std::fprintf(out, "edge starts within theta = %g of 500 random region points: mean %.1f, median %.0f, "
-                    "10th percentile %.0f, none for %.1f%% of points\n",
+  std::fprintf(out,
+               "edge starts within theta = %g of 500 random region points: mean %.1f, median %.0f, "
+               "10th percentile %.0f, none for %.1f%% of points\n",
                h.design_theta, qn.mean, qn.median, qn.p10, 100.0 * zero / counts.size());
   std::fputs("\n", out);
   print_perturbation_summary(b, out);

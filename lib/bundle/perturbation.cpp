@@ -68,7 +68,8 @@ void perturb_edge(const Simulator& sim, SimulatorWorkspace& ws, const Bundle& b,
   }
 }
 
-void prepare_perturbation(Bundle& b, const PerturbSettings& s, bool replace, const std::string& path) {
+void prepare_perturbation(Bundle& b, const PerturbSettings& s, bool replace,
+                          const std::string& path) {
   Perturbation& p = b.perturbation;
   const size_t n = b.size();
   if (p.present && !replace) {
@@ -85,7 +86,8 @@ void prepare_perturbation(Bundle& b, const PerturbSettings& s, bool replace, con
                      " perturbations per edge already; use --replace to start over with fewer");
     }
     p.perturbations = s.perturbations;
-    p.complete = std::all_of(p.done.begin(), p.done.end(), [&](uint64_t d) { return d >= s.perturbations; });
+    p.complete =
+        std::all_of(p.done.begin(), p.done.end(), [&](uint64_t d) { return d >= s.perturbations; });
     return;
   }
   p = Perturbation{};

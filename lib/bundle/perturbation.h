@@ -31,7 +31,8 @@ struct PerturbControl {
 };
 
 // Draws perturbation j of edge `edge` (norm in (0, theta]).
-JointVector perturbation_offset(const PerturbSettings& settings, int dof, uint64_t edge, uint64_t j);
+JointVector perturbation_offset(const PerturbSettings& settings, int dof, uint64_t edge,
+                                uint64_t j);
 
 struct EdgePerturbationCounts {
   uint64_t done = 0, valid = 0, lazy = 0, collision = 0;
@@ -51,7 +52,7 @@ void prepare_perturbation(Bundle& bundle, const PerturbSettings& settings, bool 
 
 enum class PerturbOutcome { Complete, Interrupted };
 
-PerturbOutcome run_perturbation(const Simulator& sim, Bundle& bundle, const PerturbSettings& settings,
-                                const PerturbControl& control);
+PerturbOutcome run_perturbation(const Simulator& sim, Bundle& bundle,
+                                const PerturbSettings& settings, const PerturbControl& control);
 
 }  // namespace lazyboe

@@ -24,7 +24,8 @@ AllowedPairsResult derive_allowed_pairs(const RobotModel& robot, long samples, u
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   JointVector q(robot.dof);
   for (long s = 0; s < samples; ++s) {
-    for (int i = 0; i < robot.dof; ++i) q[i] = robot.q_min[i] + unit(rng) * (robot.q_max[i] - robot.q_min[i]);
+    for (int i = 0; i < robot.dof; ++i)
+      q[i] = robot.q_min[i] + unit(rng) * (robot.q_max[i] - robot.q_min[i]);
     forward_kinematics(robot, robot_data, q);
     update_collision_transforms(model, data, robot_data);
     std::map<std::pair<int, int>, bool> hit;
@@ -43,7 +44,8 @@ AllowedPairsResult derive_allowed_pairs(const RobotModel& robot, long samples, u
   for (size_t a = 0; a < model.robot.size(); ++a) {
     for (size_t b = 0; b < model.robot.size(); ++b) {
       const int la = model.robot[a].link, lb = model.robot[b].link;
-      if (la < lb && model.robot[a].body == model.robot[b].body) all.emplace(std::make_pair(la, lb), -1);
+      if (la < lb && model.robot[a].body == model.robot[b].body)
+        all.emplace(std::make_pair(la, lb), -1);
     }
   }
   for (const auto& [key, count] : all) {

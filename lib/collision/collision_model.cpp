@@ -1,11 +1,11 @@
 #include "collision/collision_model.h"
 
-#include <algorithm>
-#include <cmath>
-
 #include <fcl/narrowphase/detail/convexity_based_algorithm/gjk.h>
 #include <fcl/narrowphase/detail/convexity_based_algorithm/minkowski_diff.h>
 #include <fcl/narrowphase/detail/primitive_shape_algorithm/capsule_capsule.h>
+
+#include <algorithm>
+#include <cmath>
 
 #include "common/error.h"
 
@@ -28,20 +28,28 @@ std::shared_ptr<fcl::CollisionGeometryd> make_geometry(const Shape& s, double in
 
 double bounding_radius(const Shape& s) {
   switch (s.type) {
-    case ShapeType::Sphere: return s.radius;
-    case ShapeType::Capsule: return s.radius + s.length / 2;
-    case ShapeType::Cylinder: return std::hypot(s.radius, s.length / 2);
-    case ShapeType::Box: return s.size.norm() / 2;
+    case ShapeType::Sphere:
+      return s.radius;
+    case ShapeType::Capsule:
+      return s.radius + s.length / 2;
+    case ShapeType::Cylinder:
+      return std::hypot(s.radius, s.length / 2);
+    case ShapeType::Box:
+      return s.size.norm() / 2;
   }
   return 0;
 }
 
 Eigen::Vector3d bounding_half_extents(const Shape& s) {
   switch (s.type) {
-    case ShapeType::Sphere: return Eigen::Vector3d::Constant(s.radius);
-    case ShapeType::Capsule: return Eigen::Vector3d(s.radius, s.radius, s.radius + s.length / 2);
-    case ShapeType::Cylinder: return Eigen::Vector3d(s.radius, s.radius, s.length / 2);
-    case ShapeType::Box: return s.size / 2;
+    case ShapeType::Sphere:
+      return Eigen::Vector3d::Constant(s.radius);
+    case ShapeType::Capsule:
+      return Eigen::Vector3d(s.radius, s.radius, s.radius + s.length / 2);
+    case ShapeType::Cylinder:
+      return Eigen::Vector3d(s.radius, s.radius, s.length / 2);
+    case ShapeType::Box:
+      return s.size / 2;
   }
   return Eigen::Vector3d::Zero();
 }
@@ -62,7 +70,7 @@ inline bool sphere_may_touch_box(const Eigen::Vector3d& centre, double radius,
 }
 
 inline bool spheres_may_touch(const CollisionData& data, const CollisionModel& model, int a, int b,
-                       double grow) {
+                              double grow) {
   const double r = model.robot[a].sphere_radius + model.robot[b].sphere_radius + grow;
   return (data.sphere_centre[a] - data.sphere_centre[b]).squaredNorm() <= r * r;
 }
@@ -114,8 +122,8 @@ bool env_collides(const CollisionModel& model, CollisionData& data, int a, int o
                             obstacle)) {
     return false;
   }
-  return narrow_collide(model.robot[a].inflated.get(), data.transform[a],
-                        obstacle.geometry.get(), obstacle.transform);
+  return narrow_collide(model.robot[a].inflated.get(), data.transform[a], obstacle.geometry.get(),
+                        obstacle.transform);
 }
 
 }  // namespace
@@ -132,7 +140,8 @@ CollisionModel build_collision_model(const RobotModel& robot, const Environment&
     s.in_body = robot.links[cb.link].in_body * cb.in_link;
     s.exact = make_geometry(cb.shape, 0);
     s.inflated = make_geometry(cb.shape, model.margin);
-    if (cb.shape.type == ShapeType::Capsule) s.capsule = static_cast<const fcl::Capsuled*>(s.exact.get());
+    if (cb.shape.type == ShapeType::Capsule)
+      s.capsule = static_cast<const fcl::Capsuled*>(s.exact.get());
     s.sphere_radius = bounding_radius(cb.shape);
     model.robot.push_back(s);
   }
@@ -229,10 +238,10 @@ CollisionReport check_collision(const CollisionModel& model, CollisionData& data
 DistanceReport min_distance(const CollisionModel& model, CollisionData& data) {
   DistanceReport report;
   for (const auto& [a, o] : model.env_pairs) {
-    report.env_distance = std::min(
-        report.env_distance,
-        narrow_distance(data, model.robot[a].exact.get(), data.transform[a],
-                        model.obstacles[o].geometry.get(), model.obstacles[o].transform));
+    report.env_distance =
+        std::min(report.env_distance,
+                 narrow_distance(data, model.robot[a].exact.get(), data.transform[a],
+                                 model.obstacles[o].geometry.get(), model.obstacles[o].transform));
   }
   for (const auto& [a, b] : model.self_pairs) {
     if (model.robot[a].capsule && model.robot[b].capsule) {
@@ -240,10 +249,9 @@ DistanceReport min_distance(const CollisionModel& model, CollisionData& data) {
           std::min(report.self_distance, std::max(0.0, capsule_distance(model, data, a, b)));
       continue;
     }
-    report.self_distance =
-        std::min(report.self_distance,
-                 narrow_distance(data, model.robot[a].exact.get(), data.transform[a],
-                                 model.robot[b].exact.get(), data.transform[b]));
+    report.self_distance = std::min(
+        report.self_distance, narrow_distance(data, model.robot[a].exact.get(), data.transform[a],
+                                              model.robot[b].exact.get(), data.transform[b]));
   }
   return report;
 }

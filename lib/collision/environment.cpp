@@ -23,7 +23,8 @@ Environment load_environment(const std::string& path) {
   for (const JsonField& item : root.at("objects").items()) {
     Obstacle o;
     o.name = item.at("name").string();
-    if (!names.insert(o.name).second) item.at("name").fail("duplicate object name '" + o.name + "'");
+    if (!names.insert(o.name).second)
+      item.at("name").fail("duplicate object name '" + o.name + "'");
     const std::string type = item.at("type").string();
     if (type == "box") {
       item.allow_only({"name", "type", "size", "position", "rpy", "quaternion", "allowed_links"});
@@ -35,8 +36,8 @@ Environment load_environment(const std::string& path) {
       o.shape.type = ShapeType::Sphere;
       o.shape.radius = item.at("radius").positive();
     } else if (type == "cylinder" || type == "capsule") {
-      item.allow_only({"name", "type", "radius", "length", "position", "rpy", "quaternion",
-                       "allowed_links"});
+      item.allow_only(
+          {"name", "type", "radius", "length", "position", "rpy", "quaternion", "allowed_links"});
       o.shape.type = type == "cylinder" ? ShapeType::Cylinder : ShapeType::Capsule;
       o.shape.radius = item.at("radius").positive();
       o.shape.length = item.at("length").positive();

@@ -12,7 +12,7 @@ namespace lazyboe {
 struct Obstacle {
   std::string name;
   Shape shape;
-  Pose pose;  // in the robot's base frame
+  Pose pose;                               // in the robot's base frame
   std::vector<std::string> allowed_links;  // robot links allowed to touch this obstacle
 };
 

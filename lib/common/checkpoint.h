@@ -3,8 +3,8 @@
 // the run.
 #pragma once
 
-#include <chrono>
 #include <algorithm>
+#include <chrono>
 #include <functional>
 
 namespace lazyboe {
@@ -12,7 +12,9 @@ namespace lazyboe {
 class Checkpointer {
  public:
   Checkpointer(double min_seconds, std::function<void()> save)
-      : min_seconds_(min_seconds), save_(std::move(save)), last_(std::chrono::steady_clock::now()) {}
+      : min_seconds_(min_seconds),
+        save_(std::move(save)),
+        last_(std::chrono::steady_clock::now()) {}
 
   void save_now() {
     const auto start = std::chrono::steady_clock::now();
@@ -22,7 +24,8 @@ class Checkpointer {
   }
 
   void save_if_due() {
-    const double since = std::chrono::duration<double>(std::chrono::steady_clock::now() - last_).count();
+    const double since =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - last_).count();
     if (since >= std::max(min_seconds_, 10 * cost_)) save_now();
   }
 

@@ -27,8 +27,7 @@ nlohmann::json load_json_file(const std::string& path) {
         ++column;
       }
     }
-    lazyboe::fail(path + ":" + std::to_string(line) + ":" + std::to_string(column),
-                  "invalid JSON");
+    lazyboe::fail(path + ":" + std::to_string(line) + ":" + std::to_string(column), "invalid JSON");
   }
 }
 
@@ -66,8 +65,7 @@ void JsonField::allow_only(std::initializer_list<const char*> keys) const {
     bool known = false;
     for (const char* k : keys) known = known || it.key() == k;
     if (!known) {
-      lazyboe::fail(file_ + ": " + (path_.empty() ? "" : path_ + ".") + it.key(),
-                    "unknown field");
+      lazyboe::fail(file_ + ": " + (path_.empty() ? "" : path_ + ".") + it.key(), "unknown field");
     }
   }
 }

@@ -1,5 +1,7 @@
 #include "io/csv.h"
 
+#include <unistd.h>
+
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -7,7 +9,6 @@
 #include <cstring>
 #include <fstream>
 #include <sstream>
-#include <unistd.h>
 
 #include "common/error.h"
 
@@ -44,7 +45,8 @@ std::vector<std::string> numbered_columns(const std::string& prefix, int n) {
   return out;
 }
 
-CsvTable read_numeric_csv(const std::string& path, const std::vector<std::string>& expected_header) {
+CsvTable read_numeric_csv(const std::string& path,
+                          const std::vector<std::string>& expected_header) {
   std::ifstream in(path);
   if (!in) fail(path, "cannot open file");
   CsvTable table;
@@ -78,7 +80,8 @@ CsvTable read_numeric_csv(const std::string& path, const std::vector<std::string
         fail(where, "column '" + expected_header[c] + "': not a number ('" + cells[c] + "')");
       }
       if (!std::isfinite(v) || errno == ERANGE) {
-        fail(where, "column '" + expected_header[c] + "': value must be finite ('" + cells[c] + "')");
+        fail(where,
+             "column '" + expected_header[c] + "': value must be finite ('" + cells[c] + "')");
       }
       row[c] = v;
     }

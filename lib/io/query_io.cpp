@@ -11,7 +11,8 @@ namespace {
 
 JointVector joint_vector(const JsonField& f, int dof) {
   const std::vector<double> v = f.numbers();
-  if (static_cast<int>(v.size()) != dof) f.fail("expected " + std::to_string(dof) + " joint values");
+  if (static_cast<int>(v.size()) != dof)
+    f.fail("expected " + std::to_string(dof) + " joint values");
   return Eigen::Map<const Eigen::VectorXd>(v.data(), dof);
 }
 
@@ -46,7 +47,8 @@ Query parse_query(const std::string& text, int line, const RobotModel& robot, co
   p = d.params;
   p.planner = root.has("planner") ? root.at("planner").string() : "lazyboe";
   if (p.planner != "lazyboe" && p.planner != "boe" && p.planner != "rrt" && p.planner != "sst") {
-    root.at("planner").fail("unknown planner '" + p.planner + "' (expected lazyboe, boe, rrt or sst)");
+    root.at("planner").fail("unknown planner '" + p.planner +
+                            "' (expected lazyboe, boe, rrt or sst)");
   }
   p.budget = root.has("budget") ? root.at("budget").positive() : d.budget;
   p.seed = root.has("seed") ? static_cast<uint64_t>(root.at("seed").integer()) : 1;
@@ -76,7 +78,8 @@ Query parse_query(const std::string& text, int line, const RobotModel& robot, co
     g.kind = Goal::Kind::Position;
     g.position = goal.at("position").vec3();
     g.tolerance = goal.has("tolerance") ? goal.at("tolerance").positive() : d.position_tolerance;
-    const std::string link = goal.has("link") ? goal.at("link").string() : robot.links[robot.tip_link()].name;
+    const std::string link =
+        goal.has("link") ? goal.at("link").string() : robot.links[robot.tip_link()].name;
     g.link = robot.link_index(link);
     if (g.link < 0) goal.at("link").fail("unknown link '" + link + "'");
     // Reach bound: the sum of joint offsets from the first joint on.
@@ -102,9 +105,11 @@ nlohmann::json result_json(const Query& q, const PlanResult& r, const Trajectory
   j["line"] = q.line;
   j["planner"] = q.problem.params.planner;
   j["success"] = r.success;
-  j["time_to_first_solution"] = r.success ? nlohmann::json(r.time_to_first_solution) : nlohmann::json(nullptr);
+  j["time_to_first_solution"] =
+      r.success ? nlohmann::json(r.time_to_first_solution) : nlohmann::json(nullptr);
   j["n_solutions"] = r.n_solutions;
-  j["best_cost"] = r.success ? nlohmann::json(traj ? traj->cost : r.best_cost) : nlohmann::json(nullptr);
+  j["best_cost"] =
+      r.success ? nlohmann::json(traj ? traj->cost : r.best_cost) : nlohmann::json(nullptr);
   j["counters"] = {{"nodes", r.counters.nodes},
                    {"simulations", r.counters.simulations},
                    {"lazy_edges", r.counters.lazy_edges},
@@ -117,8 +122,10 @@ nlohmann::json result_json(const Query& q, const PlanResult& r, const Trajectory
       nlohmann::json t;
       t["t"] = traj->t;
       for (size_t k = 0; k < traj->q.size(); ++k) {
-        t["q"].push_back(std::vector<double>(traj->q[k].data(), traj->q[k].data() + traj->q[k].size()));
-        t["dq"].push_back(std::vector<double>(traj->dq[k].data(), traj->dq[k].data() + traj->dq[k].size()));
+        t["q"].push_back(
+            std::vector<double>(traj->q[k].data(), traj->q[k].data() + traj->q[k].size()));
+        t["dq"].push_back(
+            std::vector<double>(traj->dq[k].data(), traj->dq[k].data() + traj->dq[k].size()));
       }
       j["trajectory"] = t;
     } else if (mode == TrajectoryOutput::Csv) {
@@ -128,7 +135,8 @@ nlohmann::json result_json(const Query& q, const PlanResult& r, const Trajectory
   return j;
 }
 
-nlohmann::json error_json(const std::string& id, int line, const std::string& planner, const std::string& error) {
+nlohmann::json error_json(const std::string& id, int line, const std::string& planner,
+                          const std::string& error) {
   nlohmann::json j;
   j["id"] = id.empty() ? nlohmann::json(nullptr) : nlohmann::json(id);
   j["line"] = line;

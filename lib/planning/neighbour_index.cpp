@@ -1,8 +1,7 @@
 #include "planning/neighbour_index.h"
 
-#include <nanoflann.hpp>
-
 #include <algorithm>
+#include <nanoflann.hpp>
 
 namespace lazyboe {
 

@@ -13,13 +13,13 @@ namespace lazyboe {
 namespace {
 
 struct Node {
-  JointVector q;       // state at rest; for a lazy node, the stored end of its edge
+  JointVector q;  // state at rest; for a lazy node, the stored end of its edge
   int parent = -1;
-  int64_t edge = -1;   // bundle edge from the parent, or index into `commands` (RRT/SST)
-  double cost = 0;     // arc length from the start (estimated for lazy nodes)
-  double h = 0;        // heuristic: distance to the goal
+  int64_t edge = -1;  // bundle edge from the parent, or index into `commands` (RRT/SST)
+  double cost = 0;    // arc length from the start (estimated for lazy nodes)
+  double h = 0;       // heuristic: distance to the goal
   bool lazy = false;
-  bool dead = false;   // failed simulation (lazy chains) or pruned (SST)
+  bool dead = false;      // failed simulation (lazy chains) or pruned (SST)
   bool inactive = false;  // SST: no longer the representative of its witness
   bool expanded = false;
 };
@@ -35,7 +35,9 @@ class SearchState {
   std::vector<Node>& nodes() { return nodes_; }
   PlanResult& result() { return result_; }
 
-  double heuristic(const JointVectorRef& q) { return problem_.goal.distance(ctx_.sim.robot, goal_data_, q); }
+  double heuristic(const JointVectorRef& q) {
+    return problem_.goal.distance(ctx_.sim.robot, goal_data_, q);
+  }
   bool in_goal(double h) const { return h <= problem_.goal.tolerance; }
 
   int add(Node n) {
@@ -84,7 +86,8 @@ JointVector row(const double* p, int n) { return Eigen::Map<const Eigen::VectorX
 
 class BundleSearch {
  public:
-  BundleSearch(const PlanningContext& ctx, SimulatorWorkspace& ws, const PlanningProblem& p, bool lazy)
+  BundleSearch(const PlanningContext& ctx, SimulatorWorkspace& ws, const PlanningProblem& p,
+               bool lazy)
       : ctx_(ctx), s_(ctx, ws, p), lazy_(lazy), theta_(p.params.theta), rng_(p.params.seed, 0) {}
 
   PlanResult run() {
@@ -110,8 +113,9 @@ class BundleSearch {
         covered = (row(b.qf(e), n) - goal.q).squaredNorm() <= reach * reach;
       }
       if (!covered) {
-        s_.result().failure = "no bundle edge ends within theta + tolerance = " + std::to_string(reach) +
-                              " rad of the goal: it is outside the bundle's coverage";
+        s_.result().failure =
+            "no bundle edge ends within theta + tolerance = " + std::to_string(reach) +
+            " rad of the goal: it is outside the bundle's coverage";
         return s_.result();
       }
     }
@@ -191,13 +195,16 @@ class BundleSearch {
     const BundleView& b = *ctx_.bundle;
     for (int u = node; s_.nodes()[u].parent >= 0; u = s_.nodes()[u].parent) {
       const CommandProfile c = b.command(s_.nodes()[u].edge);
-      steps.push_back({s_.nodes()[u].edge, std::vector<double>(c.knots, c.knots + c.n_knots * c.dof), c.duration});
+      steps.push_back({s_.nodes()[u].edge,
+                       std::vector<double>(c.knots, c.knots + c.n_knots * c.dof), c.duration});
     }
     std::reverse(steps.begin(), steps.end());
     return steps;
   }
 
-  void found(int node) { s_.solution(node, [this](int u) { return path_to(u); }); }
+  void found(int node) {
+    s_.solution(node, [this](int u) { return path_to(u); });
+  }
 
   void simulate_edge(int v, uint32_t e) {
     // The same edge from the same real node always gives the same rollout: never twice.
@@ -276,7 +283,8 @@ class BundleSearch {
   std::unordered_set<uint64_t> simulated_;  // (node, edge) pairs simulated
   double theta_;
   Random rng_;
-  std::priority_queue<std::pair<double, int>, std::vector<std::pair<double, int>>, std::greater<>> open_;
+  std::priority_queue<std::pair<double, int>, std::vector<std::pair<double, int>>, std::greater<>>
+      open_;
 };
 
 // ---- RRT and SST ----------------------------------------------------------------------------
@@ -295,7 +303,8 @@ class TreeSearch {
     s_.add(root);
     children_.push_back(0);
     if (sst_) witnesses_.push_back({root.q, 0});
-    const double delta_bn = params.selection_radius, delta_s = params.pruning_ratio * params.selection_radius;
+    const double delta_bn = params.selection_radius,
+                 delta_s = params.pruning_ratio * params.selection_radius;
     JointVector x(n);
     std::vector<double> knots;
     while (!s_.should_stop()) {
@@ -409,7 +418,8 @@ class TreeSearch {
 
   std::vector<PathStep> path_to(int node) {
     std::vector<PathStep> steps;
-    for (int u = node; s_.nodes()[u].parent >= 0; u = s_.nodes()[u].parent) steps.push_back(commands_[s_.nodes()[u].edge]);
+    for (int u = node; s_.nodes()[u].parent >= 0; u = s_.nodes()[u].parent)
+      steps.push_back(commands_[s_.nodes()[u].edge]);
     std::reverse(steps.begin(), steps.end());
     return steps;
   }
@@ -425,12 +435,14 @@ class TreeSearch {
 
 }  // namespace
 
-PlanResult plan(const PlanningContext& ctx, SimulatorWorkspace& ws, const PlanningProblem& problem) {
+PlanResult plan(const PlanningContext& ctx, SimulatorWorkspace& ws,
+                const PlanningProblem& problem) {
   const std::string& name = problem.params.planner;
   if (name == "boe" || name == "lazyboe") {
     if (!ctx.bundle || !ctx.index) fail("planner", name + " needs an edge bundle");
     if (name == "lazyboe" && !ctx.bundle->has_perturbation()) {
-      fail(ctx.bundle->path(), "has no complete perturbation analysis, which lazyboe needs (run lazyboe-perturb)");
+      fail(ctx.bundle->path(),
+           "has no complete perturbation analysis, which lazyboe needs (run lazyboe-perturb)");
     }
     if (!(problem.params.theta > 0)) fail("theta", "must be > 0");
     return BundleSearch(ctx, ws, problem, name == "lazyboe").run();

@@ -17,6 +17,7 @@ namespace lazyboe {
 
 // Runs the planner named in problem.params.planner within its budget. Throws Error for an
 // unknown planner or a planner that needs what the context lacks (a bundle, perturbation data).
-PlanResult plan(const PlanningContext& context, SimulatorWorkspace& ws, const PlanningProblem& problem);
+PlanResult plan(const PlanningContext& context, SimulatorWorkspace& ws,
+                const PlanningProblem& problem);
 
 }  // namespace lazyboe

@@ -21,17 +21,20 @@ Trajectory realize_path(const Simulator& sim, SimulatorWorkspace& ws, const Join
   std::vector<float> sq, sdq;
   for (size_t k = 0; k < steps.size(); ++k) {
     const PathStep& s = steps[k];
-    const CommandProfile profile{s.knots.data(), static_cast<int>(s.knots.size() / n), n, s.command_duration};
+    const CommandProfile profile{s.knots.data(), static_cast<int>(s.knots.size() / n), n,
+                                 s.command_duration};
     sq.clear();
     sdq.clear();
     const RolloutResult r = simulate(sampled, ws, q, profile, {&sq, &sdq});
     if (!r.valid()) {
-      fail("path", "step " + std::to_string(k) + " fails re-validation: " + rollout_status_name(r.status));
+      fail("path",
+           "step " + std::to_string(k) + " fails re-validation: " + rollout_status_name(r.status));
     }
     const size_t rows = sq.size() / n;
     for (size_t i = (k == 0 ? 0 : 1); i < rows; ++i) {  // a step starts where the last ended
       const bool last = i + 1 == rows;
-      traj.t.push_back(t0 + (last ? r.duration : static_cast<double>(i * sample_every) * sampled.dt));
+      traj.t.push_back(t0 +
+                       (last ? r.duration : static_cast<double>(i * sample_every) * sampled.dt));
       JointVector qi(n), dqi(n);
       for (int j = 0; j < n; ++j) {
         qi[j] = last ? r.qf[j] : sq[i * n + j];

@@ -19,7 +19,7 @@ namespace lazyboe {
 struct Goal {
   enum class Kind { Joint, Position };
   Kind kind = Kind::Joint;
-  JointVector q;                                   // Joint
+  JointVector q;                                       // Joint
   Eigen::Vector3d position = Eigen::Vector3d::Zero();  // Position: of `link`, base frame
   int link = -1;
   double tolerance = 0.1;  // rad (Euclidean in joint space) or m
@@ -36,14 +36,14 @@ struct PlannerParams {
   double theta = 0;                 // neighbourhood radius (bundle planners), rad
   double budget = 5.0;              // wall-clock seconds
   uint64_t seed = 1;
-  bool stop_at_first = false;       // RRT always stops at its first solution
+  bool stop_at_first = false;  // RRT always stops at its first solution
   // RRT and SST
   double goal_bias = 0.05;
   // SST: selection radius delta_BN and pruning radius delta_s = pruning_ratio * delta_BN
   double selection_radius = 0.2;
   double pruning_ratio = 1.0;
   JointVector sample_lower, sample_upper;  // state sampling box (default: the bundle's region)
-  CommandSampling command;                  // control family of RRT/SST (default: the bundle's)
+  CommandSampling command;                 // control family of RRT/SST (default: the bundle's)
 };
 
 struct PlanningProblem {
@@ -87,7 +87,7 @@ struct Trajectory {
 // Shared, read-only planning context.
 struct PlanningContext {
   const Simulator& sim;
-  const BundleView* bundle = nullptr;       // null for planners that do not use one
+  const BundleView* bundle = nullptr;  // null for planners that do not use one
   const EdgeStartIndex* index = nullptr;
 };
 

@@ -12,7 +12,8 @@ void rnea_from_poses(const RobotModel& model, RobotData& data, const JointVector
   Eigen::Vector3d w_parent = Eigen::Vector3d::Zero();
   Eigen::Vector3d dw_parent = Eigen::Vector3d::Zero();
   // Gravity enters as an upward acceleration of the base.
-  Eigen::Vector3d a_parent = with_gravity ? Eigen::Vector3d(-model.gravity) : Eigen::Vector3d::Zero();
+  Eigen::Vector3d a_parent =
+      with_gravity ? Eigen::Vector3d(-model.gravity) : Eigen::Vector3d::Zero();
   for (int i = 0; i < n; ++i) {
     const Joint& j = model.joints[i];
     const Pose& X = data.joint_pose[i];
@@ -20,7 +21,8 @@ void rnea_from_poses(const RobotModel& model, RobotData& data, const JointVector
     const Eigen::Matrix3d Rt = X.R.transpose();
     const Eigen::Vector3d w_in = Rt * w_parent;
     Eigen::Vector3d w = w_in, dw = Rt * dw_parent;
-    Eigen::Vector3d a = Rt * (a_parent + dw_parent.cross(X.p) + w_parent.cross(w_parent.cross(X.p)));
+    Eigen::Vector3d a =
+        Rt * (a_parent + dw_parent.cross(X.p) + w_parent.cross(w_parent.cross(X.p)));
     const Eigen::Vector3d s_dq = j.axis * dq[i];
     if (j.type == JointType::Revolute) {
       w += s_dq;

@@ -45,7 +45,8 @@ void update_joint_poses(const RobotModel& model, RobotData& data, const JointVec
 void forward_kinematics(const RobotModel& model, RobotData& data, const JointVectorRef& q) {
   update_joint_poses(model, data, q);
   data.body_pose[0] = data.joint_pose[0];
-  for (int i = 1; i < model.dof; ++i) data.body_pose[i] = data.body_pose[i - 1] * data.joint_pose[i];
+  for (int i = 1; i < model.dof; ++i)
+    data.body_pose[i] = data.body_pose[i - 1] * data.joint_pose[i];
 }
 
 Pose link_pose(const RobotModel& model, const RobotData& data, int link) {

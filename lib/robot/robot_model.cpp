@@ -37,8 +37,7 @@ class CapturingOutputHandler : public console_bridge::OutputHandler {
 };
 
 Pose pose_from_urdf(const urdf::Pose& pose) {
-  Eigen::Quaterniond rotation(pose.rotation.w, pose.rotation.x, pose.rotation.y,
-                              pose.rotation.z);
+  Eigen::Quaterniond rotation(pose.rotation.w, pose.rotation.x, pose.rotation.y, pose.rotation.z);
   return Pose(rotation.normalized().toRotationMatrix(),
               Eigen::Vector3d(pose.position.x, pose.position.y, pose.position.z));
 }
@@ -60,8 +59,8 @@ urdf::ModelInterfaceSharedPtr parse_urdf_file(const std::string& path) {
   urdf::ModelInterfaceSharedPtr urdf_model = urdf::parseURDF(buffer.str());
   console_bridge::restorePreviousOutputHandler();
   if (!urdf_model) {
-    fail(path, "not a valid URDF" + (handler.last_error.empty() ? std::string()
-                                                                 : " (" + handler.last_error + ")"));
+    fail(path, "not a valid URDF" +
+                   (handler.last_error.empty() ? std::string() : " (" + handler.last_error + ")"));
   }
   return urdf_model;
 }
@@ -116,8 +115,8 @@ Friction read_friction(const JsonField& f) {
 
 // Collision elements of one URDF link. A cylinder capped by two spheres of its radius at its
 // ends is the usual URDF spelling of a capsule; it becomes one capsule (cheaper and exact).
-void add_collision_bodies(RobotModel& model, const std::string& urdf_path,
-                          const urdf::Link& link, int link_index) {
+void add_collision_bodies(RobotModel& model, const std::string& urdf_path, const urdf::Link& link,
+                          int link_index) {
   struct Element {
     std::string name;
     Shape shape;
@@ -127,8 +126,8 @@ void add_collision_bodies(RobotModel& model, const std::string& urdf_path,
   std::vector<Element> elements;
   for (size_t k = 0; k < link.collision_array.size(); ++k) {
     const urdf::Collision& c = *link.collision_array[k];
-    const std::string where = urdf_path + ": link '" + link.name + "' collision " +
-                              std::to_string(k);
+    const std::string where =
+        urdf_path + ": link '" + link.name + "' collision " + std::to_string(k);
     if (!c.geometry) fail(where, "missing geometry");
     Element e;
     e.name = c.name.empty() ? link.name + "_" + std::to_string(k) : c.name;
@@ -228,18 +227,22 @@ void merge_inertia(BodyInertia& into, double mass, const Eigen::Vector3d& com,
   auto shift = [](double m, const Eigen::Vector3d& d) {
     return m * (d.squaredNorm() * Eigen::Matrix3d::Identity() - d * d.transpose());
   };
-  into.inertia_com = into.inertia_com + shift(into.mass, into.com - c) + inertia_com +
-                     shift(mass, com - c);
+  into.inertia_com =
+      into.inertia_com + shift(into.mass, into.com - c) + inertia_com + shift(mass, com - c);
   into.com = c;
   into.mass = total;
 }
 
 const char* shape_type_name(ShapeType type) {
   switch (type) {
-    case ShapeType::Sphere: return "sphere";
-    case ShapeType::Box: return "box";
-    case ShapeType::Cylinder: return "cylinder";
-    case ShapeType::Capsule: return "capsule";
+    case ShapeType::Sphere:
+      return "sphere";
+    case ShapeType::Box:
+      return "box";
+    case ShapeType::Cylinder:
+      return "cylinder";
+    case ShapeType::Capsule:
+      return "capsule";
   }
   return "?";
 }
@@ -311,8 +314,8 @@ RobotModel load_robot(const std::string& config_path) {
     chain.push_back(link);
     while (!link->child_links.empty()) {
       if (link->child_links.size() > 1) {
-        fail(config_path, "the URDF branches at link '" + link->name +
-                              "'; set tip_link to choose the chain");
+        fail(config_path,
+             "the URDF branches at link '" + link->name + "'; set tip_link to choose the chain");
       }
       link = link->child_links[0];
       chain.push_back(link);
@@ -441,8 +444,8 @@ RobotModel load_robot(const std::string& config_path) {
   }
 
   const int n = model.dof;
-  for (JointVector* v : {&model.q_min, &model.q_max, &model.dq_max, &model.ddq_max,
-                         &model.dddq_max, &model.tau_max, &model.dtau_max}) {
+  for (JointVector* v : {&model.q_min, &model.q_max, &model.dq_max, &model.ddq_max, &model.dddq_max,
+                         &model.tau_max, &model.dtau_max}) {
     v->resize(n);
   }
   for (int i = 0; i < n; ++i) {

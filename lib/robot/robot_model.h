@@ -26,7 +26,7 @@ struct Friction {
 struct Joint {
   std::string name;
   JointType type = JointType::Revolute;
-  Pose origin;  // parent body frame -> joint frame at q = 0
+  Pose origin;                                      // parent body frame -> joint frame at q = 0
   Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();  // unit, in the joint (= child body) frame
   bool axis_is_z = true;                            // the common case, with a cheaper rotation
   double lower = 0, upper = 0;                      // position limits (rad or m)
@@ -55,17 +55,17 @@ struct Link {
 enum class ShapeType { Sphere, Box, Cylinder, Capsule };
 struct Shape {
   ShapeType type = ShapeType::Sphere;
-  double radius = 0;                              // sphere, cylinder, capsule
-  double length = 0;                              // cylinder, capsule: along local z
+  double radius = 0;                               // sphere, cylinder, capsule
+  double length = 0;                               // cylinder, capsule: along local z
   Eigen::Vector3d size = Eigen::Vector3d::Zero();  // box: full extents
 };
 const char* shape_type_name(ShapeType type);
 
 struct CollisionBody {
   std::string name;
-  int link = 0;   // index into RobotModel::links
+  int link = 0;  // index into RobotModel::links
   Shape shape;
-  Pose in_link;   // shape frame in the link frame
+  Pose in_link;  // shape frame in the link frame
 };
 
 // Joint-level controller used to simulate the robot following joint-velocity commands: a
@@ -88,9 +88,9 @@ struct RobotModel {
   Eigen::Vector3d gravity{0, 0, -9.81};
   double control_rate = 1000;  // Hz
 
-  std::vector<Joint> joints;         // chain order; joint i moves body i
-  std::vector<BodyInertia> bodies;   // size dof
-  std::vector<Link> links;           // every link of the chain, base first
+  std::vector<Joint> joints;               // chain order; joint i moves body i
+  std::vector<BodyInertia> bodies;         // size dof
+  std::vector<Link> links;                 // every link of the chain, base first
   std::vector<std::string> ignored_links;  // side branches behind moving joints
   std::vector<CollisionBody> collision_bodies;
   double collision_margin = 0;

@@ -12,17 +12,19 @@ constexpr double kPeakCurvature = 5.773502691896258;  // 10 / sqrt(3)
 
 }  // namespace
 
-double max_knot_speed(const RobotModel& robot, const CommandSampling& sampling, int joint, double h) {
+double max_knot_speed(const RobotModel& robot, const CommandSampling& sampling, int joint,
+                      double h) {
   const double dv_accel = sampling.limit_scale * robot.ddq_max[joint] * h / kPeakSlope;
   const double dv_jerk = sampling.limit_scale * robot.dddq_max[joint] * h * h / kPeakCurvature;
   // Any two knots in [-V, V] differ by at most 2V.
   return std::min(sampling.velocity_scale * robot.dq_max[joint], std::min(dv_accel, dv_jerk) / 2);
 }
 
-double sample_command_profile(const RobotModel& robot, const CommandSampling& sampling,
-                              Random& rng, std::vector<double>& knots) {
+double sample_command_profile(const RobotModel& robot, const CommandSampling& sampling, Random& rng,
+                              std::vector<double>& knots) {
   const double duration = rng.uniform(sampling.min_duration, sampling.max_duration);
-  const int intervals = std::max(2, static_cast<int>(std::lround(duration / sampling.knot_interval)));
+  const int intervals =
+      std::max(2, static_cast<int>(std::lround(duration / sampling.knot_interval)));
   const double h = duration / intervals;
   const int n = robot.dof;
   knots.assign(static_cast<size_t>(intervals + 1) * n, 0.0);
@@ -43,7 +45,8 @@ void evaluate_command(const CommandProfile& p, double t, double* velocity, doubl
   if (t >= p.duration || k >= last) {
     for (int i = 0; i < n; ++i) {
       double sum = 0;
-      for (int j = 0; j < last; ++j) sum += 0.5 * h * (p.knots[j * n + i] + p.knots[(j + 1) * n + i]);
+      for (int j = 0; j < last; ++j)
+        sum += 0.5 * h * (p.knots[j * n + i] + p.knots[(j + 1) * n + i]);
       velocity[i] = 0;
       acceleration[i] = 0;
       offset[i] = sum;

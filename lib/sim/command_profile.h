@@ -32,8 +32,8 @@ struct CommandProfile {
 };
 
 // Draws a profile (duration and knots) into `knots` (resized; reserve to avoid allocating).
-double sample_command_profile(const RobotModel& robot, const CommandSampling& sampling,
-                              Random& rng, std::vector<double>& knots);
+double sample_command_profile(const RobotModel& robot, const CommandSampling& sampling, Random& rng,
+                              std::vector<double>& knots);
 
 // Velocity, acceleration and the integral of the velocity from t = 0 (the position reference
 // offset) at time t; beyond the duration the command is zero and the offset constant.
@@ -41,6 +41,7 @@ void evaluate_command(const CommandProfile& profile, double t, double* velocity,
                       double* acceleration, double* offset);
 
 // Largest knot speed allowed for joint i at knot spacing h.
-double max_knot_speed(const RobotModel& robot, const CommandSampling& sampling, int joint, double h);
+double max_knot_speed(const RobotModel& robot, const CommandSampling& sampling, int joint,
+                      double h);
 
 }  // namespace lazyboe

@@ -9,16 +9,26 @@ namespace lazyboe {
 
 const char* rollout_status_name(RolloutStatus status) {
   switch (status) {
-    case RolloutStatus::Valid: return "valid";
-    case RolloutStatus::PositionLimit: return "position_limit";
-    case RolloutStatus::VelocityLimit: return "velocity_limit";
-    case RolloutStatus::AccelerationLimit: return "acceleration_limit";
-    case RolloutStatus::JerkLimit: return "jerk_limit";
-    case RolloutStatus::TorqueLimit: return "torque_limit";
-    case RolloutStatus::TorqueRateLimit: return "torque_rate_limit";
-    case RolloutStatus::SelfCollision: return "self_collision";
-    case RolloutStatus::EnvCollision: return "env_collision";
-    case RolloutStatus::NotSettled: return "not_settled";
+    case RolloutStatus::Valid:
+      return "valid";
+    case RolloutStatus::PositionLimit:
+      return "position_limit";
+    case RolloutStatus::VelocityLimit:
+      return "velocity_limit";
+    case RolloutStatus::AccelerationLimit:
+      return "acceleration_limit";
+    case RolloutStatus::JerkLimit:
+      return "jerk_limit";
+    case RolloutStatus::TorqueLimit:
+      return "torque_limit";
+    case RolloutStatus::TorqueRateLimit:
+      return "torque_rate_limit";
+    case RolloutStatus::SelfCollision:
+      return "self_collision";
+    case RolloutStatus::EnvCollision:
+      return "env_collision";
+    case RolloutStatus::NotSettled:
+      return "not_settled";
   }
   return "?";
 }
@@ -138,7 +148,8 @@ RolloutResult simulate(const Simulator& sim, SimulatorWorkspace& ws, const Joint
   if (start != RolloutStatus::Valid) return finish(start, 0);
   push_sample(samples, q, dq);
 
-  const int max_ticks = static_cast<int>(std::ceil((profile.duration + sim.options.max_settle_time) / dt));
+  const int max_ticks =
+      static_cast<int>(std::ceil((profile.duration + sim.options.max_settle_time) / dt));
   double moved = 0;  // bound on any point's path length since the last collision check
   for (int tick = 0; tick < max_ticks; ++tick) {
     const double t = tick * dt;
@@ -176,14 +187,16 @@ RolloutResult simulate(const Simulator& sim, SimulatorWorkspace& ws, const Joint
     q_prev = q;
     for (int sub = 0; sub < sim.options.substeps; ++sub) {
       if (sim.options.integrator == Integrator::SemiImplicitEuler) {
-        k1v = sub == 0 ? forward_dynamics_from_terms(rd, tau) : forward_dynamics(robot, rd, q, dq, tau);
+        k1v = sub == 0 ? forward_dynamics_from_terms(rd, tau)
+                       : forward_dynamics(robot, rd, q, dq, tau);
         if (sub == 0) ddq = k1v;
         dq += h * k1v;
         q += h * dq;
         continue;
       }
       k1q = dq;
-      k1v = sub == 0 ? forward_dynamics_from_terms(rd, tau) : forward_dynamics(robot, rd, q, dq, tau);
+      k1v =
+          sub == 0 ? forward_dynamics_from_terms(rd, tau) : forward_dynamics(robot, rd, q, dq, tau);
       if (sub == 0) ddq = k1v;
       k2q = dq + 0.5 * h * k1v;
       k2v = forward_dynamics(robot, rd, q + 0.5 * h * k1q, k2q, tau);

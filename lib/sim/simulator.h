@@ -63,11 +63,11 @@ struct SimulatorWorkspace {
 
 struct RolloutResult {
   RolloutStatus status = RolloutStatus::Valid;
-  JointVector qf;             // final state (at rest when valid)
-  double duration = 0;        // simulated time, s
-  int ticks = 0;              // control ticks simulated
+  JointVector qf;       // final state (at rest when valid)
+  double duration = 0;  // simulated time, s
+  int ticks = 0;        // control ticks simulated
   int collision_checks = 0;
-  double path_length = 0;     // arc length of the motion in joint space, rad
+  double path_length = 0;  // arc length of the motion in joint space, rad
   bool valid() const { return status == RolloutStatus::Valid; }
 };
 
