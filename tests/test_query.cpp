@@ -75,7 +75,9 @@ std::string fresh_dir(const std::string& name) {
   return dir;
 }
 
-std::vector<double> vec(const JointVectorRef& q) { return std::vector<double>(q.data(), q.data() + q.size()); }
+std::vector<double> vec(const JointVectorRef& q) {
+  return std::vector<double>(q.data(), q.data() + q.size());
+}
 JointVector joint(const std::vector<double>& v) {
   return Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size()));
 }
@@ -102,13 +104,14 @@ constexpr double kTolerance = 0.3;
 std::string make_bundles() {
   const std::string dir = fresh_dir("bundle");
   const std::string unperturbed = dir + "/unperturbed.h5", bundle = dir + "/bundle.h5";
-  const CommandResult b = run("timeout -s KILL 300 " + quote(tool_path("lazyboe-build")) + " --out " +
-                              quote(unperturbed) + " --edges " + std::to_string(kEdges) +
-                              " --region=" + kRegion + " --theta " + std::to_string(kTheta) + " --quiet");
+  const CommandResult b =
+      run("timeout -s KILL 300 " + quote(tool_path("lazyboe-build")) + " --out " +
+          quote(unperturbed) + " --edges " + std::to_string(kEdges) + " --region=" + kRegion +
+          " --theta " + std::to_string(kTheta) + " --quiet");
   if (b.exit_code != 0) throw std::runtime_error("lazyboe-build failed: " + describe(b));
   fs::copy_file(unperturbed, bundle);
-  const CommandResult p = run("timeout -s KILL 300 " + quote(tool_path("lazyboe-perturb")) + " --bundle " +
-                              quote(bundle) + " --perturbations 4 --quiet");
+  const CommandResult p = run("timeout -s KILL 300 " + quote(tool_path("lazyboe-perturb")) +
+                              " --bundle " + quote(bundle) + " --perturbations 4 --quiet");
   if (p.exit_code != 0) throw std::runtime_error("lazyboe-perturb failed: " + describe(p));
   return bundle;
 }
@@ -132,15 +135,20 @@ struct Fixture {
   BundleView view = BundleView::open(path);
   EdgeStartIndex index{view};
   JointVector a, b;  // an easy pair: two edge starts 0.35-0.45 rad apart near the region's centre
+  JointVector c;     // an edge start 0.7-0.85 rad from a: paths of several steps
 
   Fixture() {
     const int n = data.dof();
-    const JointVector centre = (joint(data.header.region_lower) + joint(data.header.region_upper)) / 2;
+    const JointVector centre =
+        (joint(data.header.region_lower) + joint(data.header.region_upper)) / 2;
     std::vector<size_t> order(data.size());
     for (size_t e = 0; e < order.size(); ++e) order[e] = e;
-    auto start = [&](size_t e) { return joint(std::vector<double>(&data.q0[e * n], &data.q0[e * n] + n)); };
-    std::sort(order.begin(), order.end(),
-              [&](size_t x, size_t y) { return (start(x) - centre).norm() < (start(y) - centre).norm(); });
+    auto start = [&](size_t e) {
+      return joint(std::vector<double>(&data.q0[e * n], &data.q0[e * n] + n));
+    };
+    std::sort(order.begin(), order.end(), [&](size_t x, size_t y) {
+      return (start(x) - centre).norm() < (start(y) - centre).norm();
+    });
     for (size_t i = 0; i < 60 && a.size() == 0; ++i) {
       for (size_t j = i + 1; j < 60; ++j) {
         const double d = (start(order[i]) - start(order[j])).norm();
@@ -151,7 +159,13 @@ struct Fixture {
         }
       }
     }
-    if (a.size() == 0) throw std::runtime_error("no easy start/goal pair among the bundle's edge starts");
+    if (a.size() == 0)
+      throw std::runtime_error("no easy start/goal pair among the bundle's edge starts");
+    for (size_t i = 0; i < order.size() && c.size() == 0; ++i) {
+      const double d = (start(order[i]) - a).norm();
+      if (d >= 0.7 && d <= 0.85) c = start(order[i]);
+    }
+    if (c.size() == 0) throw std::runtime_error("no edge start 0.7-0.85 rad from the easy start");
   }
 
   JointVector edge_start(size_t e) const {
@@ -160,9 +174,19 @@ struct Fixture {
   }
 };
 
+// Built on first use; a failure is reported by every test without building again.
 const Fixture& fixture() {
-  static const Fixture f;
-  return f;
+  static std::string failure;
+  static const Fixture* f = []() -> const Fixture* {
+    try {
+      return new Fixture();
+    } catch (const std::exception& e) {
+      failure = e.what();
+      return nullptr;
+    }
+  }();
+  if (!f) throw std::runtime_error("the test bundle could not be set up: " + failure);
+  return *f;
 }
 
 // ------------------------------------------------------------------------------------------
@@ -222,7 +246,8 @@ ToolRun query_tool(const std::vector<std::string>& args) {
 }
 
 // Runs a batch (written to <temp>/<name>.jsonl) on the fixture's bundle.
-ToolRun run_batch(const std::string& name, const std::vector<json>& queries, std::vector<std::string> extra = {}) {
+ToolRun run_batch(const std::string& name, const std::vector<json>& queries,
+                  std::vector<std::string> extra = {}) {
   const std::string file = write_temp_file(name + ".jsonl", jsonl(queries));
   std::vector<std::string> args = {"--bundle", fixture().path, "--queries", file};
   args.insert(args.end(), extra.begin(), extra.end());
@@ -239,7 +264,9 @@ json timeless(json r) {
 // Independent re-validation of a trajectory
 // ------------------------------------------------------------------------------------------
 
-bool is_bundle_planner(const std::string& planner) { return planner == "lazyboe" || planner == "boe"; }
+bool is_bundle_planner(const std::string& planner) {
+  return planner == "lazyboe" || planner == "boe";
+}
 
 Trajectory trajectory_from_json(const json& r) {
   Trajectory t;
@@ -265,7 +292,8 @@ std::string validate(const Fixture& f, const Trajectory& traj, const JointVector
   if (rows < 2) return "  fewer than two samples\n";
   if (traj.q.size() != rows || traj.dq.size() != rows) return "  t, q and dq differ in length\n";
   for (size_t k = 0; k < rows; ++k) {
-    if (traj.q[k].size() != n || traj.dq[k].size() != n) return "  a sample does not have 7 values\n";
+    if (traj.q[k].size() != n || traj.dq[k].size() != n)
+      return "  a sample does not have 7 values\n";
   }
   int reported = 0;
   auto report = [&](const std::string& what) {
@@ -275,20 +303,21 @@ std::string validate(const Fixture& f, const Trajectory& traj, const JointVector
   if (traj.t[0] != 0) report("t[0] = " + std::to_string(traj.t[0]) + ", expected 0");
   for (size_t k = 1; k < rows; ++k) {
     if (!(traj.t[k] > traj.t[k - 1])) {
-      report("t not strictly increasing at sample " + std::to_string(k) + ": " + std::to_string(traj.t[k - 1]) +
-             " then " + std::to_string(traj.t[k]));
+      report("t not strictly increasing at sample " + std::to_string(k) + ": " +
+             std::to_string(traj.t[k - 1]) + " then " + std::to_string(traj.t[k]));
     }
   }
   if (std::abs(traj.duration - traj.t.back()) > 1e-9) {
-    report("duration " + std::to_string(traj.duration) + " differs from the last t " + std::to_string(traj.t.back()));
+    report("duration " + std::to_string(traj.duration) + " differs from the last t " +
+           std::to_string(traj.t.back()));
   }
   // Start: exactly the query's start, at rest.
   const double start_error = (traj.q[0] - start).cwiseAbs().maxCoeff();
   if (!(start_error <= 1e-12)) {
     std::ostringstream s;
     s.precision(17);
-    s << "first q differs from the query start by " << start_error << " rad (max over joints): " << str(traj.q[0])
-      << " vs " << str(start);
+    s << "first q differs from the query start by " << start_error
+      << " rad (max over joints): " << str(traj.q[0]) << " vs " << str(start);
     report(s.str());
   }
   if (!(traj.dq[0].cwiseAbs().maxCoeff() == 0)) report("first dq is not zero: " + str(traj.dq[0]));
@@ -305,27 +334,27 @@ std::string validate(const Fixture& f, const Trajectory& traj, const JointVector
     const JointVector& dq = traj.dq[k];
     for (int j = 0; j < n; ++j) {
       if (!(q[j] >= robot.q_min[j] && q[j] <= robot.q_max[j])) {
-        report("sample " + std::to_string(k) + ": q" + std::to_string(j + 1) + " = " + std::to_string(q[j]) +
-               " outside the joint limits");
+        report("sample " + std::to_string(k) + ": q" + std::to_string(j + 1) + " = " +
+               std::to_string(q[j]) + " outside the joint limits");
       }
       if (!(std::abs(dq[j]) <= robot.dq_max[j])) {
-        report("sample " + std::to_string(k) + ": dq" + std::to_string(j + 1) + " = " + std::to_string(dq[j]) +
-               " beyond the velocity limit");
+        report("sample " + std::to_string(k) + ": dq" + std::to_string(j + 1) + " = " +
+               std::to_string(dq[j]) + " beyond the velocity limit");
       }
     }
     const RolloutStatus s = check_state(f.sim, ws, q);
     if (s != RolloutStatus::Valid) {
-      report("sample " + std::to_string(k) + " (t = " + std::to_string(traj.t[k]) + "): check_state says " +
-             rollout_status_name(s));
+      report("sample " + std::to_string(k) + " (t = " + std::to_string(traj.t[k]) +
+             "): check_state says " + rollout_status_name(s));
     }
     if (k > 0) {
       const double dt = traj.t[k] - traj.t[k - 1];
       for (int j = 0; j < n; ++j) {
         const double jump = std::abs(q[j] - traj.q[k - 1][j]);
         if (jump > robot.dq_max[j] * dt + 1e-6) {
-          report("discontinuity between samples " + std::to_string(k - 1) + " and " + std::to_string(k) +
-                 ": joint " + std::to_string(j + 1) + " moves " + std::to_string(jump) + " rad in " +
-                 std::to_string(dt) + " s");
+          report("discontinuity between samples " + std::to_string(k - 1) + " and " +
+                 std::to_string(k) + ": joint " + std::to_string(j + 1) + " moves " +
+                 std::to_string(jump) + " rad in " + std::to_string(dt) + " s");
         }
       }
     }
@@ -334,7 +363,8 @@ std::string validate(const Fixture& f, const Trajectory& traj, const JointVector
   if (traj.edges.empty()) report("no edges listed");
   for (int64_t e : traj.edges) {
     if (is_bundle_planner(planner)) {
-      if (e < 0 || e >= static_cast<int64_t>(f.view.size())) report("edge " + std::to_string(e) + " is not a bundle edge");
+      if (e < 0 || e >= static_cast<int64_t>(f.view.size()))
+        report("edge " + std::to_string(e) + " is not a bundle edge");
     } else if (e != -1) {
       report("edge " + std::to_string(e) + " listed for an " + planner + " command (expected -1)");
     }
@@ -345,8 +375,8 @@ std::string validate(const Fixture& f, const Trajectory& traj, const JointVector
 
 // Simulates `commands` one after another from `start` (each from the previous simulated end)
 // and compares the end and the total time with the trajectory's. Empty when they agree.
-std::string resimulate(const Fixture& f, const JointVectorRef& start, const std::vector<CommandProfile>& commands,
-                       const Trajectory& traj) {
+std::string resimulate(const Fixture& f, const JointVectorRef& start,
+                       const std::vector<CommandProfile>& commands, const Trajectory& traj) {
   std::ostringstream p;
   p.precision(17);
   SimulatorWorkspace ws(f.sim);
@@ -355,7 +385,8 @@ std::string resimulate(const Fixture& f, const JointVectorRef& start, const std:
   for (size_t k = 0; k < commands.size(); ++k) {
     const RolloutResult r = simulate(f.sim, ws, q, commands[k]);
     if (!r.valid()) {
-      p << "  step " << k << " fails when simulated from the previous end: " << rollout_status_name(r.status) << "\n";
+      p << "  step " << k
+        << " fails when simulated from the previous end: " << rollout_status_name(r.status) << "\n";
       return p.str();
     }
     q = r.qf;
@@ -363,11 +394,12 @@ std::string resimulate(const Fixture& f, const JointVectorRef& start, const std:
   }
   const double error = (q - traj.q.back()).cwiseAbs().maxCoeff();
   if (!(error <= 1e-9)) {
-    p << "  re-simulated end " << str(q) << " differs from the trajectory's last q " << str(traj.q.back()) << " by "
-      << error << " rad\n";
+    p << "  re-simulated end " << str(q) << " differs from the trajectory's last q "
+      << str(traj.q.back()) << " by " << error << " rad\n";
   }
   if (!(std::abs(time - traj.t.back()) <= 1e-9)) {
-    p << "  re-simulated duration " << time << " s differs from the trajectory's " << traj.t.back() << " s\n";
+    p << "  re-simulated duration " << time << " s differs from the trajectory's " << traj.t.back()
+      << " s\n";
   }
   return p.str();
 }
@@ -395,8 +427,9 @@ struct LibraryRun {
   std::string error;  // plan or realize_path threw
 };
 
-PlanningProblem library_problem(const Fixture& f, const JointVectorRef& start, const JointVectorRef& goal,
-                                const std::string& planner, double budget) {
+PlanningProblem library_problem(const Fixture& f, const JointVectorRef& start,
+                                const JointVectorRef& goal, const std::string& planner,
+                                double budget) {
   const BundleHeader& h = f.view.header();
   PlanningProblem p;
   p.start = start;
@@ -436,7 +469,8 @@ const std::vector<LibraryRun>& library_runs() {
         try {
           r.result = plan(context, ws, r.problem);
           if (r.result.success) {
-            r.trajectory = realize_path(f.sim, ws, r.problem.start, r.result.best_path, r.problem.goal, kSampleEvery);
+            r.trajectory = realize_path(f.sim, ws, r.problem.start, r.result.best_path,
+                                        r.problem.goal, kSampleEvery);
             r.realized = true;
           }
         } catch (const std::exception& e) {
@@ -455,26 +489,38 @@ const ToolRun& tool_easy_run() {
   static const ToolRun run = [] {
     const Fixture& f = fixture();
     std::vector<json> queries;
-    for (const std::string& p : kPlanners) queries.push_back(query(p, f.a, f.b, p, easy_budget(p), false));
-    return run_batch("easy", queries, {"--trajectories", "inline", "--jobs", "2", "--quiet"});
+    for (const std::string& p : kPlanners)
+      queries.push_back(query(p, f.a, f.b, p, easy_budget(p), false));
+    return run_batch("easy", queries, {"--trajectories", "inline", "--jobs", "4", "--quiet"});
   }();
   return run;
 }
 
-// A batch that stops at the first solution (deterministic for a fixed seed): every planner
-// a -> b, and LazyBoE and BoE b -> a.
+// A batch that stops at the first solution (deterministic for a fixed seed; the budgets are
+// only a bound, far above the time the first solution takes): every planner a -> b, LazyBoE and
+// BoE b -> a, and last LazyBoE and BoE a -> c (paths of several steps, the slowest queries).
 std::vector<json> deterministic_queries() {
   const Fixture& f = fixture();
   std::vector<json> q;
-  for (const std::string& p : kPlanners) q.push_back(query(p + "-ab", f.a, f.b, p, easy_budget(p), true, 3));
-  q.push_back(query("lazyboe-ba", f.b, f.a, "lazyboe", 2, true, 5));
-  q.push_back(query("boe-ba", f.b, f.a, "boe", 2, true, 5));
+  for (const std::string& p : kPlanners) q.push_back(query(p + "-ab", f.a, f.b, p, 5, true, 3));
+  q.push_back(query("lazyboe-ba", f.b, f.a, "lazyboe", 5, true, 5));
+  q.push_back(query("boe-ba", f.b, f.a, "boe", 5, true, 5));
+  q.push_back(query("lazyboe-ac", f.a, f.c, "lazyboe", 10, true, 7));
+  q.push_back(query("boe-ac", f.a, f.c, "boe", 10, true, 7));
+  return q;
+}
+
+// Its quick part (all but the a -> c queries), for the tests that compare other ways of running
+// the tool with the reference run below.
+std::vector<json> quick_queries() {
+  std::vector<json> q = deterministic_queries();
+  q.resize(q.size() - 2);
   return q;
 }
 
 const ToolRun& deterministic_run() {
-  static const ToolRun run =
-      run_batch("deterministic", deterministic_queries(), {"--trajectories", "inline", "--jobs", "1", "--quiet"});
+  static const ToolRun run = run_batch("deterministic", deterministic_queries(),
+                                       {"--trajectories", "inline", "--jobs", "1", "--quiet"});
   return run;
 }
 
@@ -523,6 +569,9 @@ TEST(Query, EveryPlannerSolvesAnEasyProblemThroughLibraryAndTool) {
     EXPECT_GE(r.value("n_solutions", 0), 1);
     EXPECT_TRUE(r.contains("trajectory")) << "no inline trajectory";
     EXPECT_FALSE(r.contains("failure"));
+    std::cout << "[ path    ] " << kPlanners[i] << ": edges " << r.value("edges", json()).dump()
+              << ", cost " << r.value("best_cost", json()).dump() << ", counters "
+              << r.value("counters", json()).dump() << "\n";
   }
 }
 
@@ -560,10 +609,64 @@ TEST(Query, EveryReturnedTrajectoryPassesIndependentRevalidation) {
     SCOPED_TRACE("tool (stop_at_first batch), " + r.value("id", ""));
     const JointVector start = joint(queries[i]["start"].get<std::vector<double>>());
     const JointVector goal = joint(queries[i]["goal"]["q"].get<std::vector<double>>());
-    EXPECT_EQ(validate(f, trajectory_from_json(r), start, goal, kTolerance, r.value("planner", "")), "");
+    EXPECT_EQ(validate(f, trajectory_from_json(r), start, goal, kTolerance, r.value("planner", "")),
+              "");
     ++checked;
   }
-  EXPECT_GE(checked, 8 + static_cast<int>(queries.size()) - 2) << "too few trajectories to check";
+  EXPECT_EQ(checked, 8 + static_cast<int>(queries.size()))
+      << "every query should have returned a trajectory";
+}
+
+// The checks above must catch what they look for: broken copies of a valid trajectory.
+TEST(Query, TheRevalidationCatchesBrokenTrajectories) {
+  const Fixture& f = fixture();
+  const LibraryRun* run = nullptr;
+  for (const LibraryRun& r : library_runs()) {
+    if (r.realized && r.planner == "boe") run = &r;
+  }
+  ASSERT_NE(run, nullptr) << "boe found no path";
+  const Trajectory& good = run->trajectory;
+  ASSERT_GE(good.t.size(), 4u);
+  const size_t mid = good.t.size() / 2;
+  auto problems = [&](const Trajectory& t) {
+    return validate(f, t, t.q[0], f.b, kTolerance, "boe");
+  };
+  SimulatorWorkspace ws(f.sim);
+  JointVector collide = good.q[mid];
+  while (check_state(f.sim, ws, collide) == RolloutStatus::Valid && collide[1] < f.robot.q_max[1])
+    collide[1] += 0.05;
+  ASSERT_NE(check_state(f.sim, ws, collide), RolloutStatus::Valid);
+
+  Trajectory t = good;
+  t.t[mid] = t.t[mid - 1];
+  EXPECT_TRUE(contains(problems(t), "strictly increasing")) << problems(t);
+  t = good;
+  t.dq[0][3] = 0.01;
+  EXPECT_TRUE(contains(problems(t), "first dq")) << problems(t);
+  t = good;
+  t.q[mid][2] += 0.2;
+  EXPECT_TRUE(contains(problems(t), "discontinuity")) << problems(t);
+  t = good;
+  t.q[mid] = collide;
+  EXPECT_TRUE(contains(problems(t), "check_state")) << problems(t);
+  t = good;
+  t.dq[mid][0] = f.robot.dq_max[0] * 1.01;
+  EXPECT_TRUE(contains(problems(t), "velocity limit")) << problems(t);
+  t = good;
+  t.q.back() = f.a;
+  EXPECT_TRUE(contains(problems(t), "from the goal")) << problems(t);
+  t = good;
+  t.edges.back() = static_cast<int64_t>(f.view.size());
+  EXPECT_TRUE(contains(problems(t), "not a bundle edge")) << problems(t);
+  EXPECT_TRUE(contains(validate(f, good, f.b, f.b, kTolerance, "boe"), "query start"));
+  // An end state that is not the simulated one (a stored, lazy end would differ like this).
+  t = good;
+  t.q.back()[6] += 1e-6;
+  EXPECT_TRUE(contains(resimulate(f, f.a, bundle_commands(f, good.edges), t), "differs"));
+  t = good;
+  t.t.back() += 0.01;
+  EXPECT_TRUE(contains(resimulate(f, f.a, bundle_commands(f, good.edges), t), "duration"));
+  EXPECT_EQ(resimulate(f, f.a, bundle_commands(f, good.edges), good), "");
 }
 
 // ------------------------------------------------------------------------------------------
@@ -580,7 +683,8 @@ TEST(Query, OutputsAreMadeOfSimulatedEdgesOnly) {
     // the trajectory ends; for the bundle planners the edge ids name the same commands.
     std::vector<CommandProfile> commands;
     for (const PathStep& s : r.result.best_path) {
-      commands.push_back({s.knots.data(), static_cast<int>(s.knots.size() / f.robot.dof), f.robot.dof, s.command_duration});
+      commands.push_back({s.knots.data(), static_cast<int>(s.knots.size() / f.robot.dof),
+                          f.robot.dof, s.command_duration});
     }
     EXPECT_EQ(resimulate(f, f.a, commands, r.trajectory), "");
     if (is_bundle_planner(r.planner)) {
@@ -594,7 +698,8 @@ TEST(Query, OutputsAreMadeOfSimulatedEdgesOnly) {
       EXPECT_EQ(r.result.counters.lazy_edges, 0u);
     }
   }
-  auto check_tool = [&](const ToolRun& t, const std::vector<JointVector>& starts, const std::string& what) {
+  auto check_tool = [&](const ToolRun& t, const std::vector<JointVector>& starts,
+                        const std::string& what) {
     for (size_t i = 0; i < t.results.size() && i < starts.size(); ++i) {
       const json& r = t.results[i];
       const std::string planner = r.value("planner", "");
@@ -616,9 +721,11 @@ TEST(Query, OutputsAreMadeOfSimulatedEdgesOnly) {
   std::vector<JointVector> starts(kPlanners.size(), f.a);
   check_tool(tool_easy_run(), starts, "tool (easy batch)");
   starts.clear();
-  for (const json& q : deterministic_queries()) starts.push_back(joint(q["start"].get<std::vector<double>>()));
+  for (const json& q : deterministic_queries())
+    starts.push_back(joint(q["start"].get<std::vector<double>>()));
   check_tool(deterministic_run(), starts, "tool (stop_at_first batch)");
-  EXPECT_TRUE(lazy_somewhere) << "lazyboe never took an edge lazily (counters.lazy_edges = 0 everywhere)";
+  EXPECT_TRUE(lazy_somewhere)
+      << "lazyboe never took an edge lazily (counters.lazy_edges = 0 everywhere)";
 }
 
 // ------------------------------------------------------------------------------------------
@@ -640,7 +747,8 @@ TEST(Query, FixedSeedAndOneJobGiveIdenticalResults) {
     EXPECT_EQ(x.value("success", false), y.value("success", false));
     EXPECT_EQ(x.value("n_solutions", -1), y.value("n_solutions", -2));
     EXPECT_EQ(x.value("edges", json()), y.value("edges", json()));
-    EXPECT_TRUE(x.value("trajectory", json()) == y.value("trajectory", json())) << "trajectories differ";
+    EXPECT_TRUE(x.value("trajectory", json()) == y.value("trajectory", json()))
+        << "trajectories differ";
     // Everything else too, but the wall-clock time.
     EXPECT_EQ(timeless(x).dump(), timeless(y).dump());
   }
@@ -660,7 +768,8 @@ TEST(Query, BadLinesGetErrorResultsAndTheOthersStillSucceed) {
     collide[1] += 0.05;
     s = check_state(f.sim, ws, collide);
   }
-  ASSERT_EQ(s, RolloutStatus::EnvCollision) << "leaning forward ended with " << rollout_status_name(s);
+  ASSERT_EQ(s, RolloutStatus::EnvCollision)
+      << "leaning forward ended with " << rollout_status_name(s);
   JointVector outside = f.a;
   outside[0] = f.robot.q_max[0] + 0.1;
   ASSERT_EQ(check_state(f.sim, ws, outside), RolloutStatus::PositionLimit);
@@ -669,15 +778,15 @@ TEST(Query, BadLinesGetErrorResultsAndTheOthersStillSucceed) {
   const std::vector<double> seven = vec(f.a);
   six["start"] = std::vector<double>(seven.begin(), seven.begin() + 6);
   std::vector<std::string> lines = {
-      query("good-1", f.a, f.b, "lazyboe", 2, true).dump(),              // line 1
-      query("collide", collide, f.b, "lazyboe", 1, true).dump(),         // line 2
-      "",                                                                // line 3 (blank)
-      "{\"id\": \"broken\", \"start\": [0, 0,",                          // line 4: not JSON
-      six.dump(),                                                        // line 5
-      query("unknown", f.a, f.b, "astar", 1, true).dump(),               // line 6
-      "   ",                                                             // line 7 (blank)
-      query("limits", outside, f.b, "boe", 1, true).dump(),              // line 8
-      query("good-2", f.b, f.a, "boe", 2, true).dump(),                  // line 9
+      query("good-1", f.a, f.b, "lazyboe", 2, true).dump(),       // line 1
+      query("collide", collide, f.b, "lazyboe", 1, true).dump(),  // line 2
+      "",                                                         // line 3 (blank)
+      "{\"id\": \"broken\", \"start\": [0, 0,",                   // line 4: not JSON
+      six.dump(),                                                 // line 5
+      query("unknown", f.a, f.b, "astar", 1, true).dump(),        // line 6
+      "   ",                                                      // line 7 (blank)
+      query("limits", outside, f.b, "boe", 1, true).dump(),       // line 8
+      query("good-2", f.b, f.a, "boe", 2, true).dump(),           // line 9
   };
   std::string text;
   for (const std::string& l : lines) text += l + "\n";
@@ -699,7 +808,8 @@ TEST(Query, BadLinesGetErrorResultsAndTheOthersStillSucceed) {
       {8, "limits", {"start", "limit"}},
       {9, "good-2", {}},
   };
-  ASSERT_EQ(t.results.size(), expected.size()) << "one result per non-empty line\n" << describe(t.r);
+  ASSERT_EQ(t.results.size(), expected.size()) << "one result per non-empty line\n"
+                                               << describe(t.r);
   for (size_t i = 0; i < expected.size(); ++i) {
     const json& r = t.results[i];
     const Expected& e = expected[i];
@@ -717,8 +827,10 @@ TEST(Query, BadLinesGetErrorResultsAndTheOthersStillSucceed) {
     EXPECT_EQ(r.value("success", true), false);
     ASSERT_TRUE(r.contains("error") && r["error"].is_string());
     const std::string error = r["error"];
-    EXPECT_TRUE(contains(error, "line " + std::to_string(e.line))) << "does not name its line: " << error;
-    for (const std::string& word : e.reason) EXPECT_TRUE(contains(error, word)) << "no '" << word << "' in: " << error;
+    EXPECT_TRUE(contains(error, "line " + std::to_string(e.line)))
+        << "does not name its line: " << error;
+    for (const std::string& word : e.reason)
+      EXPECT_TRUE(contains(error, word)) << "no '" << word << "' in: " << error;
   }
 }
 
@@ -747,7 +859,8 @@ TEST(Query, MemoryMappedAndReadIntoMemoryGiveIdenticalAnswers) {
       if (mapped.q0(e)[j] != read.q0(e)[j] || mapped.q0(e)[j] != truth.q0[e * n + j]) ++mismatches;
       if (mapped.qf(e)[j] != read.qf(e)[j] || mapped.qf(e)[j] != truth.qf[e * n + j]) ++mismatches;
     }
-    if (mapped.duration(e) != read.duration(e) || mapped.duration(e) != truth.duration[e]) ++mismatches;
+    if (mapped.duration(e) != read.duration(e) || mapped.duration(e) != truth.duration[e])
+      ++mismatches;
     const CommandProfile cm = mapped.command(e), cr = read.command(e);
     if (cm.n_knots != cr.n_knots || cm.dof != cr.dof || cm.duration != cr.duration ||
         cm.duration != truth.command_duration[e] ||
@@ -755,28 +868,32 @@ TEST(Query, MemoryMappedAndReadIntoMemoryGiveIdenticalAnswers) {
       ++mismatches;
     } else {
       for (int k = 0; k < cm.n_knots * n; ++k) {
-        if (cm.knots[k] != cr.knots[k] || cm.knots[k] != truth.knots[truth.knot_offset[e] * n + k]) {
+        if (cm.knots[k] != cr.knots[k] ||
+            cm.knots[k] != truth.knots[truth.knot_offset[e] * n + k]) {
           ++mismatches;
           break;
         }
       }
     }
-    if (mapped.p_lazy_prop(e) != read.p_lazy_prop(e) || mapped.p_lazy_prop(e) != truth.perturbation.p_lazy_prop[e]) {
+    if (mapped.p_lazy_prop(e) != read.p_lazy_prop(e) ||
+        mapped.p_lazy_prop(e) != truth.perturbation.p_lazy_prop[e]) {
       ++mismatches;
     }
-    if (mapped.p_collision(e) != read.p_collision(e) || mapped.p_collision(e) != truth.perturbation.p_collision[e]) {
+    if (mapped.p_collision(e) != read.p_collision(e) ||
+        mapped.p_collision(e) != truth.perturbation.p_collision[e]) {
       ++mismatches;
     }
-    EXPECT_EQ(mismatches, before) << "edge " << e << " differs between the mapped, read and stored bundle";
+    EXPECT_EQ(mismatches, before) << "edge " << e
+                                  << " differs between the mapped, read and stored bundle";
   }
   EXPECT_EQ(mismatches, 0u);
 
   // The tool with and without --no-mmap: the same results.
-  const std::vector<json> queries = deterministic_queries();
+  const std::vector<json> queries = quick_queries();
   const ToolRun& mapped_run = deterministic_run();
-  expect_batch_ran(mapped_run, queries.size());
-  const ToolRun read_run =
-      run_batch("deterministic", queries, {"--trajectories", "inline", "--jobs", "1", "--quiet", "--no-mmap"});
+  expect_batch_ran(mapped_run, deterministic_queries().size());
+  const ToolRun read_run = run_batch(
+      "quick", queries, {"--trajectories", "inline", "--jobs", "1", "--quiet", "--no-mmap"});
   expect_batch_ran(read_run, queries.size());
   for (size_t i = 0; i < queries.size(); ++i) {
     SCOPED_TRACE(queries[i]["id"].get<std::string>());
@@ -807,7 +924,8 @@ TEST(Query, IncompleteMissingAndUnperturbedBundlesAreRefused) {
       EXPECT_TRUE(contains(e.what(), incomplete_path)) << e.what();
     }
   }
-  const std::string good = write_temp_file("refused/one.jsonl", query("q", f.a, f.b, "boe", 1, true).dump() + "\n");
+  const std::string good =
+      write_temp_file("refused/one.jsonl", query("q", f.a, f.b, "boe", 1, true).dump() + "\n");
   const ToolRun t1 = query_tool({"--bundle", incomplete_path, "--queries", good});
   EXPECT_EQ(t1.r.exit_code, 1) << describe(t1.r);
   EXPECT_EQ(count_lines(t1.r.err), 1) << describe(t1.r);
@@ -831,9 +949,9 @@ TEST(Query, IncompleteMissingAndUnperturbedBundlesAreRefused) {
   // boe on the same bundle still works.
   const BundleView plain = BundleView::open(f.unperturbed);
   EXPECT_FALSE(plain.has_perturbation());
-  const std::string batch = write_temp_file(
-      "refused/unperturbed.jsonl",
-      jsonl({query("lazy", f.a, f.b, "lazyboe", 1, true), query("plain", f.a, f.b, "boe", 2, true)}));
+  const std::string batch = write_temp_file("refused/unperturbed.jsonl",
+                                            jsonl({query("lazy", f.a, f.b, "lazyboe", 1, true),
+                                                   query("plain", f.a, f.b, "boe", 2, true)}));
   const ToolRun t3 = query_tool({"--bundle", f.unperturbed, "--queries", batch, "--quiet"});
   ASSERT_EQ(t3.r.exit_code, 0) << describe(t3.r);
   ASSERT_EQ(t3.results.size(), 2u) << describe(t3.r);
@@ -861,12 +979,12 @@ TEST(Query, IncompleteMissingAndUnperturbedBundlesAreRefused) {
 
 TEST(Query, StreamingFromStandardInputFlushesOneLinePerQuery) {
   const Fixture& f = fixture();
-  const std::vector<json> queries = deterministic_queries();
+  const std::vector<json> queries = quick_queries();
   const ToolRun& file_run = deterministic_run();
-  expect_batch_ran(file_run, queries.size());
+  expect_batch_ran(file_run, deterministic_queries().size());
   const std::string dir = fresh_dir("stream");
-  const std::string first = dir + "/first.jsonl", rest = dir + "/rest.jsonl", out = dir + "/out.jsonl",
-                    err = dir + "/err.txt", seen = dir + "/seen.txt";
+  const std::string first = dir + "/first.jsonl", rest = dir + "/rest.jsonl",
+                    out = dir + "/out.jsonl", err = dir + "/err.txt", seen = dir + "/seen.txt";
   std::ofstream(first) << queries[0].dump() << "\n";
   {
     std::ofstream r(rest);
@@ -874,16 +992,19 @@ TEST(Query, StreamingFromStandardInputFlushesOneLinePerQuery) {
   }
   // The producer sends the first query, waits (up to 30 s) for its result to appear in the
   // output while standard input is still open, notes how many lines it saw, then sends the rest.
-  const std::string producer = "( cat " + quote(first) + "; i=0; while [ $i -lt 300 ]; do " +
-                               "[ \"$(wc -l < " + quote(out) + " 2>/dev/null || echo 0)\" -ge 1 ] && break; " +
-                               "sleep 0.1; i=$((i+1)); done; (wc -l < " + quote(out) + " 2>/dev/null || echo 0) > " +
-                               quote(seen) + "; cat " + quote(rest) + " )";
-  const std::string consumer = query_command({"--bundle", f.path, "--queries", "-", "--trajectories", "inline", "--quiet"});
-  const CommandResult r = run("bash -c " + quote(producer + " | " + consumer + " > " + quote(out) + " 2> " + quote(err)));
+  const std::string producer =
+      "( cat " + quote(first) + "; i=0; while [ $i -lt 300 ]; do " + "[ \"$(wc -l < " + quote(out) +
+      " 2>/dev/null || echo 0)\" -ge 1 ] && break; " + "sleep 0.1; i=$((i+1)); done; (wc -l < " +
+      quote(out) + " 2>/dev/null || echo 0) > " + quote(seen) + "; cat " + quote(rest) + " )";
+  const std::string consumer =
+      query_command({"--bundle", f.path, "--queries", "-", "--trajectories", "inline", "--quiet"});
+  const CommandResult r = run(
+      "bash -c " + quote(producer + " | " + consumer + " > " + quote(out) + " 2> " + quote(err)));
   ASSERT_EQ(r.exit_code, 0) << describe(r) << read_file(err);
   std::string seen_text = read_file(seen);
   seen_text.erase(std::remove_if(seen_text.begin(), seen_text.end(), ::isspace), seen_text.end());
-  EXPECT_EQ(seen_text, "1") << "the first result was not written (flushed) while standard input was still open";
+  EXPECT_EQ(seen_text, "1")
+      << "the first result was not written (flushed) while standard input was still open";
   std::string problems;
   const std::vector<json> streamed = parse_lines(read_file(out), problems);
   ASSERT_TRUE(problems.empty()) << problems;
@@ -902,12 +1023,14 @@ TEST(Query, StreamingFromStandardInputFlushesOneLinePerQuery) {
 TEST(Query, RobotOrEnvironmentOtherThanTheBundlesIsRefusedAtStart) {
   const Fixture& f = fixture();
   const std::string dir = fresh_dir("identity");
-  const std::string queries = write_temp_file("identity/q.jsonl", query("q", f.a, f.b, "boe", 1, true).dump() + "\n");
+  const std::string queries =
+      write_temp_file("identity/q.jsonl", query("q", f.a, f.b, "boe", 1, true).dump() + "\n");
   // The bundle's own robot and environment, given explicitly: accepted.
   {
     const std::string out = dir + "/same.jsonl";
-    const ToolRun t = query_tool({"--bundle", f.path, "--queries", queries, "--out", out, "--quiet", "--robot",
-                                  f.data.header.robot_config, "--env", f.data.header.env_file});
+    const ToolRun t =
+        query_tool({"--bundle", f.path, "--queries", queries, "--out", out, "--quiet", "--robot",
+                    f.data.header.robot_config, "--env", f.data.header.env_file});
     EXPECT_EQ(t.r.exit_code, 0) << describe(t.r);
     EXPECT_TRUE(fs::exists(out));
   }
@@ -922,7 +1045,8 @@ TEST(Query, RobotOrEnvironmentOtherThanTheBundlesIsRefusedAtStart) {
     std::vector<std::string> args;
     std::string names;
   };
-  for (const Case& c : {Case{{"--robot", other_robot}, other_robot}, Case{{"--env", shelf}, shelf}}) {
+  for (const Case& c :
+       {Case{{"--robot", other_robot}, other_robot}, Case{{"--env", shelf}, shelf}}) {
     SCOPED_TRACE(c.names);
     const std::string out = dir + "/refused.jsonl";
     std::vector<std::string> args = {"--bundle", f.path, "--queries", queries, "--out", out};
@@ -937,7 +1061,8 @@ TEST(Query, RobotOrEnvironmentOtherThanTheBundlesIsRefusedAtStart) {
 }
 
 // Parses a CSV file into its header and rows of numbers.
-bool read_csv(const std::string& path, std::string& header, std::vector<std::vector<double>>& rows) {
+bool read_csv(const std::string& path, std::string& header,
+              std::vector<std::vector<double>>& rows) {
   std::ifstream in(path);
   if (!in) return false;
   std::getline(in, header);
@@ -955,13 +1080,14 @@ bool read_csv(const std::string& path, std::string& header, std::vector<std::vec
 
 TEST(Query, CsvTrajectoriesHaveTheInlineRows) {
   const Fixture& f = fixture();
-  const std::vector<json> queries = deterministic_queries();
+  const std::vector<json> queries = quick_queries();
   const ToolRun& inline_run = deterministic_run();
-  expect_batch_ran(inline_run, queries.size());
+  expect_batch_ran(inline_run, deterministic_queries().size());
   const std::string dir = fresh_dir("csv");
   const std::string traj_dir = dir + "/trajectories";
-  const ToolRun t = run_batch("deterministic", queries,
-                              {"--trajectories", "csv", "--trajectory-dir", traj_dir, "--jobs", "1", "--quiet"});
+  const ToolRun t =
+      run_batch("quick", queries,
+                {"--trajectories", "csv", "--trajectory-dir", traj_dir, "--jobs", "1", "--quiet"});
   expect_batch_ran(t, queries.size());
   std::string expected_header = "t";
   for (int i = 1; i <= 7; ++i) expected_header += ",q" + std::to_string(i);
@@ -996,7 +1122,9 @@ TEST(Query, CsvTrajectoriesHaveTheInlineRows) {
       for (size_t c = 0; c < 15; ++c) {
         // Written with 10 significant digits.
         if (std::abs(rows[k][c] - want[c]) > 1e-9 * std::max(1.0, std::abs(want[c]))) {
-          if (bad++ < 5) ADD_FAILURE() << "row " << k << " column " << c << ": " << rows[k][c] << " vs " << want[c];
+          if (bad++ < 5)
+            ADD_FAILURE() << "row " << k << " column " << c << ": " << rows[k][c] << " vs "
+                          << want[c];
         }
       }
     }
@@ -1032,13 +1160,15 @@ double nearest_distance(const Fixture& f, const JointVectorRef& q, bool ends) {
 
 // A collision-free state within the limits whose first joint is moved by one of `offsets`
 // from `base`, farther than `clearance` from every edge start (or end).
-JointVector far_state(const Fixture& f, const JointVectorRef& base, const std::vector<double>& offsets,
-                      double clearance, bool ends) {
+JointVector far_state(const Fixture& f, const JointVectorRef& base,
+                      const std::vector<double>& offsets, double clearance, bool ends) {
   SimulatorWorkspace ws(f.sim);
   for (double d : offsets) {
     JointVector q = base;
     q[0] += d;
-    if (check_state(f.sim, ws, q) == RolloutStatus::Valid && nearest_distance(f, q, ends) > clearance) return q;
+    if (check_state(f.sim, ws, q) == RolloutStatus::Valid &&
+        nearest_distance(f, q, ends) > clearance)
+      return q;
   }
   return JointVector();
 }
@@ -1048,7 +1178,8 @@ TEST(Query, StartOrGoalOutsideTheCoverageFailsWithAReason) {
   const double theta = f.view.perturbation_theta();
   const JointVector far_start = far_state(f, f.a, {1.5, -1.5, 2.0, -2.0, 1.2, -1.2}, theta, false);
   ASSERT_EQ(far_start.size(), 7) << "no collision-free state far from the bundle's starts";
-  const JointVector far_goal = far_state(f, f.b, {2.2, -2.2, 2.5, -2.5, 1.8, -1.8}, theta + kTolerance, true);
+  const JointVector far_goal =
+      far_state(f, f.b, {2.2, -2.2, 2.5, -2.5, 1.8, -1.8}, theta + kTolerance, true);
   ASSERT_EQ(far_goal.size(), 7) << "no collision-free state far from the bundle's ends";
 
   // Library: a clear failure at once, not a timeout.
@@ -1059,8 +1190,8 @@ TEST(Query, StartOrGoalOutsideTheCoverageFailsWithAReason) {
       SCOPED_TRACE(planner + std::string(start_is_far ? ", far start" : ", far goal"));
       const auto t0 = Clock::now();
       const PlanResult r = plan(context, ws,
-                                library_problem(f, start_is_far ? far_start : f.a, start_is_far ? f.b : far_goal,
-                                                planner, 5));
+                                library_problem(f, start_is_far ? far_start : f.a,
+                                                start_is_far ? f.b : far_goal, planner, 5));
       const double seconds = std::chrono::duration<double>(Clock::now() - t0).count();
       EXPECT_FALSE(r.success);
       EXPECT_LT(seconds, 1.0) << "ran into its 5 s budget instead of failing at once";
@@ -1071,9 +1202,10 @@ TEST(Query, StartOrGoalOutsideTheCoverageFailsWithAReason) {
     }
   }
   // Tool: the reason in the result.
-  const ToolRun t = run_batch("far", {query("far-start", far_start, f.b, "lazyboe", 3, false),
-                                      query("far-goal", f.a, far_goal, "lazyboe", 3, false),
-                                      query("far-start-boe", far_start, f.b, "boe", 3, false)},
+  const ToolRun t = run_batch("far",
+                              {query("far-start", far_start, f.b, "lazyboe", 3, false),
+                               query("far-goal", f.a, far_goal, "lazyboe", 3, false),
+                               query("far-start-boe", far_start, f.b, "boe", 3, false)},
                               {"--quiet"});
   ASSERT_EQ(t.r.exit_code, 0) << describe(t.r);
   ASSERT_EQ(t.results.size(), 3u) << describe(t.r);
@@ -1086,8 +1218,10 @@ TEST(Query, StartOrGoalOutsideTheCoverageFailsWithAReason) {
     EXPECT_TRUE(contains(failure, "theta") && contains(failure, "bundle")) << failure;
     EXPECT_FALSE(contains(failure, "time budget")) << failure;
   }
-  std::cout << "[ reason  ] far start: " << (t.results.empty() ? "" : t.results[0].value("failure", "")) << "\n"
-            << "[ reason  ] far goal:  " << (t.results.size() < 2 ? "" : t.results[1].value("failure", "")) << "\n";
+  std::cout << "[ reason  ] far start: "
+            << (t.results.empty() ? "" : t.results[0].value("failure", "")) << "\n"
+            << "[ reason  ] far goal:  "
+            << (t.results.size() < 2 ? "" : t.results[1].value("failure", "")) << "\n";
 }
 
 }  // namespace

@@ -35,10 +35,12 @@ Trajectory realize_path(const Simulator& sim, SimulatorWorkspace& ws, const Join
       const bool last = i + 1 == rows;
       traj.t.push_back(t0 +
                        (last ? r.duration : static_cast<double>(i * sample_every) * sampled.dt));
+      // The start and each step's end are exact; samples in between are stored as float32
+      // by the simulator (to about 1e-7 rad).
       JointVector qi(n), dqi(n);
       for (int j = 0; j < n; ++j) {
-        qi[j] = last ? r.qf[j] : sq[i * n + j];
-        dqi[j] = sdq[i * n + j];
+        qi[j] = last ? r.qf[j] : (k == 0 && i == 0) ? start[j] : sq[i * n + j];
+        dqi[j] = (k == 0 && i == 0) ? 0.0 : sdq[i * n + j];
       }
       traj.q.push_back(qi);
       traj.dq.push_back(dqi);
