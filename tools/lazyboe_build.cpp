@@ -77,22 +77,9 @@ Integrator parse_integrator(const std::string& name) {
 }
 
 void print_summary(const Bundle& b) {
-  const BundleHeader& h = b.header;
   std::fprintf(stderr, "lazyboe-build: %zu edges (%s)\n", b.size(),
-               h.complete ? "complete" : "incomplete");
-  std::fprintf(stderr, "  attempts %llu, valid %llu (%.1f%%), start states resampled %llu\n",
-               static_cast<unsigned long long>(h.attempts),
-               static_cast<unsigned long long>(h.valid),
-               h.attempts ? 100.0 * h.valid / h.attempts : 0.0,
-               static_cast<unsigned long long>(h.start_resamples));
-  for (const auto& [reason, count] : h.rejected) {
-    std::fprintf(stderr, "  rejected %-20s %llu\n", reason.c_str(),
-                 static_cast<unsigned long long>(count));
-  }
-  std::fprintf(stderr, "  simulated %.1f s in %.1f s wall: %.0f attempts/s, %.0f valid edges/s\n",
-               h.simulated_seconds, h.wall_seconds,
-               h.wall_seconds > 0 ? h.attempts / h.wall_seconds : 0.0,
-               h.wall_seconds > 0 ? h.valid / h.wall_seconds : 0.0);
+               b.header.complete ? "complete" : "incomplete");
+  print_build_summary(b.header, stderr);
 }
 
 }  // namespace

@@ -84,6 +84,22 @@ void print_perturbation_summary(const Bundle& b, std::FILE* out) {
                qs.mean, 100.0 * usable / N, 100.0 * never / N);
 }
 
+void print_build_summary(const BundleHeader& h, std::FILE* out) {
+  std::fprintf(out, "  attempts %llu, valid %llu (%.1f%%), start states resampled %llu\n",
+               static_cast<unsigned long long>(h.attempts),
+               static_cast<unsigned long long>(h.valid),
+               h.attempts ? 100.0 * h.valid / h.attempts : 0.0,
+               static_cast<unsigned long long>(h.start_resamples));
+  for (const auto& [reason, count] : h.rejected) {
+    std::fprintf(out, "  rejected %-20s %llu\n", reason.c_str(),
+                 static_cast<unsigned long long>(count));
+  }
+  std::fprintf(out, "  simulated %.1f s in %.1f s wall: %.0f attempts/s, %.0f valid edges/s\n",
+               h.simulated_seconds, h.wall_seconds,
+               h.wall_seconds > 0 ? h.attempts / h.wall_seconds : 0.0,
+               h.wall_seconds > 0 ? h.valid / h.wall_seconds : 0.0);
+}
+
 void print_inspection(const std::string& path, std::FILE* out) {
   const Bundle b = read_bundle(path);
   const BundleHeader& h = b.header;
@@ -108,16 +124,8 @@ void print_inspection(const std::string& path, std::FILE* out) {
                h.integrator.c_str(), h.substeps, h.control_rate, h.sample_interval);
   std::fprintf(out, "  region:");
   for (int i = 0; i < n; ++i) std::fprintf(out, " [%g, %g]", h.region_lower[i], h.region_upper[i]);
-  std::fprintf(out, "\n  attempts %llu, valid %llu (%.1f%%), start states resampled %llu\n",
-               static_cast<unsigned long long>(h.attempts),
-               static_cast<unsigned long long>(h.valid),
-               h.attempts ? 100.0 * h.valid / h.attempts : 0.0,
-               static_cast<unsigned long long>(h.start_resamples));
-  for (const auto& [reason, count] : h.rejected) {
-    std::fprintf(out, "    rejected %-20s %llu\n", reason.c_str(),
-                 static_cast<unsigned long long>(count));
-  }
-  std::fprintf(out, "  simulated %.1f s, wall %.1f s\n", h.simulated_seconds, h.wall_seconds);
+  std::fprintf(out, "\n");
+  print_build_summary(h, out);
   if (N == 0) return;
 
   std::vector<double> displacement(N);

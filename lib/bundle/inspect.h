@@ -11,6 +11,9 @@ namespace lazyboe {
 
 void print_inspection(const std::string& path, std::FILE* out);
 
+// The build's tally: attempts, valid share, rejections by reason, simulated and wall time.
+void print_build_summary(const BundleHeader& header, std::FILE* out);
+
 // The perturbation analysis of a bundle: settings, distributions of both probabilities
 // (text histograms) and the share of edges usable for lazy propagation.
 void print_perturbation_summary(const Bundle& bundle, std::FILE* out);
