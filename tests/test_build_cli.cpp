@@ -29,6 +29,7 @@
 
 #include "bundle/bundle.h"
 #include "bundle/bundle_file.h"
+#include "cli_util.h"
 #include "test_util.h"
 
 extern char** environ;
@@ -42,12 +43,6 @@ using Clock = std::chrono::steady_clock;
 // ------------------------------------------------------------------------------------------
 // Running the tool
 // ------------------------------------------------------------------------------------------
-
-std::string quote(const std::string& s) {
-  std::string out = "'";
-  for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return out + "'";
-}
 
 // The shell command line of lazyboe-build with the given arguments (each shell-quoted). A
 // watchdog kills a run that does not end, so a tool that misreads its input fails the test
@@ -69,71 +64,6 @@ CommandResult build_tool_in(const std::string& dir, const std::vector<std::strin
   return run("cd " + quote(dir) + " && " + build_command(args, timeout_seconds));
 }
 
-std::string describe(const CommandResult& r) {
-  return "exit " + std::to_string(r.exit_code) + "\n--- stdout:\n" + r.out + "--- stderr:\n" +
-         r.err;
-}
-
-long count_lines(const std::string& s) { return std::count(s.begin(), s.end(), '\n'); }
-
-bool contains(const std::string& haystack, const std::string& needle) {
-  return haystack.find(needle) != std::string::npos;
-}
-
-// A failure as the tools promise it: a normal non-zero exit (no signal, no abort, no watchdog
-// kill), nothing on stdout, and exactly one line on stderr that contains every one of `needles`.
-void expect_one_line_error(const CommandResult& r, const std::vector<std::string>& needles) {
-  std::string problems;
-  if (r.exit_code == 0) problems += "  exit status 0 (expected failure)\n";
-  if (r.exit_code < 0 || r.exit_code >= 124)
-    problems += "  exit status looks like a signal, crash or timeout\n";
-  if (count_lines(r.err) != 1 || r.err.empty() || r.err.back() != '\n') {
-    problems +=
-        "  expected exactly one line on stderr, got " + std::to_string(count_lines(r.err)) + "\n";
-  }
-  if (!r.out.empty()) problems += "  stdout is not empty\n";
-  for (const std::string& n : needles) {
-    if (!contains(r.err, n)) problems += "  stderr does not mention '" + n + "'\n";
-  }
-  EXPECT_TRUE(problems.empty()) << problems << describe(r);
-}
-
-// A fresh, empty directory under the test's temp dir.
-std::string fresh_dir(const std::string& name) {
-  const std::string dir = temp_dir() + "/" + name;
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
-
-std::vector<std::string> files_in(const std::string& dir) {
-  std::vector<std::string> out;
-  for (const auto& e : fs::directory_iterator(dir)) out.push_back(e.path().filename().string());
-  std::sort(out.begin(), out.end());
-  return out;
-}
-
-std::string join(const std::vector<std::string>& v) {
-  std::string s;
-  for (const std::string& x : v) s += (s.empty() ? "" : ", ") + x;
-  return s;
-}
-
-// Temporary files of the crash-safe writer ("<path>.tmp.<pid>").
-std::vector<std::string> tmp_files_in(const std::string& dir) {
-  std::vector<std::string> out;
-  for (const std::string& f : files_in(dir)) {
-    if (contains(f, ".tmp.")) out.push_back(f);
-  }
-  return out;
-}
-
-// Every file of a directory with its bytes.
-std::map<std::string, std::string> snapshot(const std::string& dir) {
-  std::map<std::string, std::string> out;
-  for (const std::string& f : files_in(dir)) out[f] = read_file(dir + "/" + f);
-  return out;
-}
 
 std::string env_file(const std::string& name) { return source_path("data/environments/" + name); }
 
@@ -199,26 +129,6 @@ bool wait_for_file(const Background& b, const std::string& path, double timeout_
 // ------------------------------------------------------------------------------------------
 // Comparing bundles
 // ------------------------------------------------------------------------------------------
-
-// Bit-for-bit equality of two arrays, reporting the first difference.
-template <typename T>
-::testing::AssertionResult same_array(const std::string& name, const std::vector<T>& a,
-                                      const std::vector<T>& b) {
-  if (a.size() != b.size()) {
-    return ::testing::AssertionFailure()
-           << name << ": " << a.size() << " vs " << b.size() << " values";
-  }
-  for (size_t i = 0; i < a.size(); ++i) {
-    if (std::memcmp(&a[i], &b[i], sizeof(T)) != 0) {
-      std::ostringstream o;
-      o.precision(17);
-      o << name << ": first difference at element " << i << " of " << a.size() << ": " << a[i]
-        << " vs " << b[i];
-      return ::testing::AssertionFailure() << o.str();
-    }
-  }
-  return ::testing::AssertionSuccess();
-}
 
 bool same_double(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 
@@ -591,23 +501,6 @@ struct BadCase {
 std::string expand(const std::string& s, const std::string& dir) {
   if (s.rfind("@OUT", 0) == 0) return dir + "/out.h5" + s.substr(4);
   if (s.rfind("@DIR", 0) == 0) return dir + s.substr(4);
-  return s;
-}
-
-void write_bytes(const std::string& path, const std::string& bytes) {
-  std::FILE* f = std::fopen(path.c_str(), "wb");
-  ASSERT_NE(f, nullptr) << path;
-  std::fwrite(bytes.data(), 1, bytes.size(), f);
-  std::fclose(f);
-}
-
-std::string garbage_bytes() {
-  std::string s;
-  uint32_t x = 12345;
-  for (int i = 0; i < 4096; ++i) {
-    x = x * 1664525u + 1013904223u;
-    s += static_cast<char>(x >> 24);
-  }
   return s;
 }
 

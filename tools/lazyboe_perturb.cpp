@@ -3,19 +3,15 @@
 // the counts behind them) are written into the same bundle file.
 #include <cstdio>
 
+#include "bundle/builder.h"
 #include "bundle/bundle_file.h"
 #include "bundle/inspect.h"
 #include "bundle/perturbation.h"
-#include "common/hash.h"
 #include "tool_main.h"
 
 namespace {
 
 using namespace lazyboe;
-
-Integrator integrator_of(const BundleHeader& h) {
-  return h.integrator == "rk4" ? Integrator::RK4 : Integrator::SemiImplicitEuler;
-}
 
 }  // namespace
 
@@ -55,27 +51,11 @@ int main(int argc, char** argv) {
     if (!(s.theta > 0)) fail("--theta", "must be > 0");
     if (s.perturbations >= (1ULL << 24)) fail("--perturbations", "must be below 16777216");
 
-    // The bundle's robot and environment, checked by content: never assumed.
-    if (robot_path.empty()) robot_path = h.robot_config;
-    if (env_path.empty()) env_path = h.env_file;
-    const RobotModel robot = load_robot(robot_path);
-    const std::string robot_hash = hash_files({robot.config_path, robot.urdf_path});
-    if (robot_hash != h.robot_hash) {
-      fail(robot_path, "is not the robot the bundle was built with (" + h.robot_config + ", hash " +
-                           h.robot_hash + "; this one hashes to " + robot_hash + ")");
-    }
-    const Environment env = load_environment(env_path);
-    const std::string env_hash = hash_files({env.path});
-    if (env_hash != h.env_hash) {
-      fail(env_path, "is not the environment the bundle was built with (" + h.env_file + ", hash " +
-                         h.env_hash + "; this one hashes to " + env_hash + ")");
-    }
-    const CollisionModel collision = build_collision_model(robot, env);
-    SimulationOptions options;
-    options.integrator = integrator_of(h);
-    options.substeps = h.substeps;
+    const BundleScene scene = load_bundle_scene(h, robot_path, env_path);
+    const CollisionModel collision = build_collision_model(scene.robot, scene.env);
+    SimulationOptions options = settings_from_header(h).simulation;
     options.sample_every = 0;
-    const Simulator sim(robot, collision, options);
+    const Simulator sim(scene.robot, collision, options);
 
     prepare_perturbation(bundle, s, replace, bundle_path);
     if (bundle.perturbation.complete) {

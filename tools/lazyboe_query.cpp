@@ -10,8 +10,8 @@
 #include <iostream>
 #include <map>
 
+#include "bundle/builder.h"
 #include "bundle/bundle_view.h"
-#include "common/hash.h"
 #include "common/histogram.h"
 #include "io/query_io.h"
 #include "planning/planners.h"
@@ -91,20 +91,11 @@ int main(int argc, char** argv) {
     const auto t0 = Clock::now();
     const BundleView bundle = BundleView::open(bundle_path, !no_mmap);
     const BundleHeader& h = bundle.header();
-    if (robot_path.empty()) robot_path = h.robot_config;
-    if (env_path.empty()) env_path = h.env_file;
-    const RobotModel robot = load_robot(robot_path);
-    if (hash_files({robot.config_path, robot.urdf_path}) != h.robot_hash) {
-      fail(robot_path, "is not the robot the bundle was built with (" + h.robot_config + ")");
-    }
-    const Environment env = load_environment(env_path);
-    if (hash_files({env.path}) != h.env_hash) {
-      fail(env_path, "is not the environment the bundle was built with (" + h.env_file + ")");
-    }
-    const CollisionModel collision = build_collision_model(robot, env);
-    SimulationOptions options;
-    options.integrator = h.integrator == "rk4" ? Integrator::RK4 : Integrator::SemiImplicitEuler;
-    options.substeps = h.substeps;
+    const BundleScene scene = load_bundle_scene(h, robot_path, env_path);
+    const RobotModel& robot = scene.robot;
+    const CollisionModel collision = build_collision_model(robot, scene.env);
+    const BuildSettings settings = settings_from_header(h);
+    SimulationOptions options = settings.simulation;
     options.sample_every = 0;
     const Simulator sim(robot, collision, options);
     const EdgeStartIndex index(bundle);
@@ -120,13 +111,9 @@ int main(int argc, char** argv) {
 
     QueryDefaults defaults;
     defaults.theta = bundle.has_perturbation() ? bundle.perturbation_theta() : h.design_theta;
-    defaults.params.sample_lower = Eigen::Map<const Eigen::VectorXd>(h.region_lower.data(), h.dof);
-    defaults.params.sample_upper = Eigen::Map<const Eigen::VectorXd>(h.region_upper.data(), h.dof);
-    defaults.params.command.min_duration = h.min_duration;
-    defaults.params.command.max_duration = h.max_duration;
-    defaults.params.command.knot_interval = h.knot_interval;
-    defaults.params.command.velocity_scale = h.velocity_scale;
-    defaults.params.command.limit_scale = h.limit_scale;
+    defaults.params.sample_lower = settings.region_lower;
+    defaults.params.sample_upper = settings.region_upper;
+    defaults.params.command = settings.command;
     const PlanningContext context{sim, &bundle, &index};
     const int sample_every =
         std::max(1, static_cast<int>(std::lround(sample_interval * robot.control_rate)));

@@ -16,36 +16,7 @@ namespace lazyboe {
 
 namespace ds = bundle_dataset;
 
-BundleView::BundleView(BundleView&& o) noexcept { *this = std::move(o); }
-
-BundleView& BundleView::operator=(BundleView&& o) noexcept {
-  if (this == &o) return *this;
-  if (map_) ::munmap(map_, map_bytes_);
-  path_ = std::move(o.path_);
-  header_ = std::move(o.header_);
-  edges_ = o.edges_;
-  map_ = o.map_;
-  map_bytes_ = o.map_bytes_;
-  all_mapped_ = o.all_mapped_;
-  owned_ = std::move(o.owned_);
-  warnings_ = std::move(o.warnings_);
-  q0_ = o.q0_;
-  qf_ = o.qf_;
-  duration_ = o.duration_;
-  command_duration_ = o.command_duration_;
-  knot_offset_ = o.knot_offset_;
-  knots_ = o.knots_;
-  p_lazy_prop_ = o.p_lazy_prop_;
-  p_collision_ = o.p_collision_;
-  perturbation_theta_ = o.perturbation_theta_;
-  has_perturbation_ = o.has_perturbation_;
-  o.map_ = nullptr;
-  return *this;
-}
-
-BundleView::~BundleView() {
-  if (map_) ::munmap(map_, map_bytes_);
-}
+void FileUnmap::operator()(void* address) const { ::munmap(address, bytes); }
 
 CommandProfile BundleView::command(size_t e) const {
   const int n = dof();
@@ -68,8 +39,8 @@ const T* BundleView::attach(long file, const std::string& dataset,
   if (allow_mmap && map_) {
     const DatasetLocation loc = dataset_location(path_, file, dataset);
     if (loc.contiguous && loc.bytes == count * sizeof(T) && loc.file_offset % alignof(T) == 0 &&
-        loc.file_offset + loc.bytes <= map_bytes_) {
-      return reinterpret_cast<const T*>(static_cast<const char*>(map_) + loc.file_offset);
+        loc.file_offset + loc.bytes <= map_.get_deleter().bytes) {
+      return reinterpret_cast<const T*>(static_cast<const char*>(map_.get()) + loc.file_offset);
     }
     warnings_.push_back(
         dataset + " cannot be memory-mapped (chunked, compressed or unaligned): read into memory");
@@ -96,8 +67,7 @@ BundleView BundleView::open(const std::string& path, bool allow_mmap) {
     if (::fstat(fd, &st) == 0 && st.st_size > 0) {
       void* map = ::mmap(nullptr, static_cast<size_t>(st.st_size), PROT_READ, MAP_SHARED, fd, 0);
       if (map != MAP_FAILED) {
-        v.map_ = map;
-        v.map_bytes_ = static_cast<size_t>(st.st_size);
+        v.map_ = std::unique_ptr<void, FileUnmap>(map, FileUnmap{static_cast<size_t>(st.st_size)});
       }
     }
     ::close(fd);  // the mapping stays valid

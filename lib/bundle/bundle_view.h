@@ -15,15 +15,17 @@
 
 namespace lazyboe {
 
+// Unmaps a read-only file mapping of `bytes` bytes.
+struct FileUnmap {
+  size_t bytes = 0;
+  void operator()(void* address) const;
+};
+
 class BundleView {
  public:
   // Throws Error for a missing, corrupt or incomplete bundle. `allow_mmap = false` reads
   // every dataset into memory (the fallback path, also used to compare both).
   static BundleView open(const std::string& path, bool allow_mmap = true);
-
-  BundleView(BundleView&&) noexcept;
-  BundleView& operator=(BundleView&&) noexcept;
-  ~BundleView();
 
   const std::string& path() const { return path_; }
   const BundleHeader& header() const { return header_; }
@@ -52,9 +54,9 @@ class BundleView {
   std::string path_;
   BundleHeader header_;
   size_t edges_ = 0;
-  // The file mapping (whole file, read-only) and datasets read into memory instead.
-  void* map_ = nullptr;
-  size_t map_bytes_ = 0;
+  // The read-only mapping of the whole file (unmapped with the view) and datasets read into
+  // memory instead.
+  std::unique_ptr<void, FileUnmap> map_;
   bool all_mapped_ = false;
   std::vector<std::shared_ptr<void>> owned_;
   std::vector<std::string> warnings_;

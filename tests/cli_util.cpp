@@ -1,0 +1,100 @@
+#include "cli_util.h"
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+
+namespace lazyboe::test {
+
+namespace fs = std::filesystem;
+
+long count_lines(const std::string& s) { return std::count(s.begin(), s.end(), '\n'); }
+
+std::string quote(const std::string& s) {
+  std::string out = "'";
+  for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return out + "'";
+}
+
+std::string describe(const CommandResult& r) {
+  return "exit " + std::to_string(r.exit_code) + "\n--- stdout:\n" + r.out + "--- stderr:\n" +
+         r.err;
+}
+
+bool contains(const std::string& haystack, const std::string& needle) {
+  return haystack.find(needle) != std::string::npos;
+}
+
+std::string join(const std::vector<std::string>& v) {
+  std::string s;
+  for (const std::string& x : v) s += (s.empty() ? "" : ", ") + x;
+  return s;
+}
+
+// A failure as the tools promise it: a normal non-zero exit (no signal, no abort, no watchdog
+// kill), nothing on stdout, and exactly one line on stderr that contains every one of `needles`.
+void expect_one_line_error(const CommandResult& r, const std::vector<std::string>& needles) {
+  std::string problems;
+  if (r.exit_code == 0) problems += "  exit status 0 (expected failure)\n";
+  if (r.exit_code < 0 || r.exit_code >= 124)
+    problems += "  exit status looks like a signal, crash or timeout\n";
+  if (count_lines(r.err) != 1 || r.err.empty() || r.err.back() != '\n') {
+    problems +=
+        "  expected exactly one line on stderr, got " + std::to_string(count_lines(r.err)) + "\n";
+  }
+  if (!r.out.empty()) problems += "  stdout is not empty\n";
+  for (const std::string& n : needles) {
+    if (!contains(r.err, n)) problems += "  stderr does not mention '" + n + "'\n";
+  }
+  EXPECT_TRUE(problems.empty()) << problems << describe(r);
+}
+
+// A fresh, empty directory under the test's temp dir.
+std::string fresh_dir(const std::string& name) {
+  const std::string dir = temp_dir() + "/" + name;
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+std::vector<std::string> files_in(const std::string& dir) {
+  std::vector<std::string> out;
+  for (const auto& e : fs::directory_iterator(dir)) out.push_back(e.path().filename().string());
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+// Temporary files of the crash-safe writer ("<path>.tmp.<pid>").
+std::vector<std::string> tmp_files_in(const std::string& dir) {
+  std::vector<std::string> out;
+  for (const std::string& f : files_in(dir)) {
+    if (contains(f, ".tmp.")) out.push_back(f);
+  }
+  return out;
+}
+
+// Every file of a directory with its bytes.
+std::map<std::string, std::string> snapshot(const std::string& dir) {
+  std::map<std::string, std::string> out;
+  for (const std::string& f : files_in(dir)) out[f] = read_file(dir + "/" + f);
+  return out;
+}
+
+void write_bytes(const std::string& path, const std::string& bytes) {
+  std::FILE* f = std::fopen(path.c_str(), "wb");
+  ASSERT_NE(f, nullptr) << path;
+  std::fwrite(bytes.data(), 1, bytes.size(), f);
+  std::fclose(f);
+}
+
+std::string garbage_bytes() {
+  std::string s;
+  uint32_t x = 12345;
+  for (int i = 0; i < 4096; ++i) {
+    x = x * 1664525u + 1013904223u;
+    s += static_cast<char>(x >> 24);
+  }
+  return s;
+}
+
+}  // namespace lazyboe::test

@@ -1,0 +1,65 @@
+// Helpers shared by the command-line tests: running tools, one-line error checks, comparing
+// directories before and after a refused run, bit-exact array comparison.
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "test_util.h"
+
+namespace lazyboe::test {
+
+long count_lines(const std::string& s);
+std::string quote(const std::string& s);
+
+std::string describe(const CommandResult& r);
+
+bool contains(const std::string& haystack, const std::string& needle);
+
+std::string join(const std::vector<std::string>& v);
+
+// A failure as the tools promise it: a normal non-zero exit (no signal, no abort, no watchdog
+// kill), nothing on stdout, and exactly one line on stderr that contains every one of `needles`.
+void expect_one_line_error(const CommandResult& r, const std::vector<std::string>& needles);
+
+// A fresh, empty directory under the test's temp dir.
+std::string fresh_dir(const std::string& name);
+
+std::vector<std::string> files_in(const std::string& dir);
+
+// Temporary files of the crash-safe writer ("<path>.tmp.<pid>").
+std::vector<std::string> tmp_files_in(const std::string& dir);
+
+// Every file of a directory with its bytes.
+std::map<std::string, std::string> snapshot(const std::string& dir);
+
+void write_bytes(const std::string& path, const std::string& bytes);
+
+std::string garbage_bytes();
+
+// Bit-for-bit equality of two arrays, reporting the first difference.
+template <typename T>
+::testing::AssertionResult same_array(const std::string& name, const std::vector<T>& a,
+                                      const std::vector<T>& b) {
+  if (a.size() != b.size()) {
+    return ::testing::AssertionFailure()
+           << name << ": " << a.size() << " vs " << b.size() << " values";
+  }
+  for (size_t i = 0; i < a.size(); ++i) {
+    if (std::memcmp(&a[i], &b[i], sizeof(T)) != 0) {
+      std::ostringstream o;
+      o.precision(17);
+      o << name << ": first difference at element " << i << " of " << a.size() << ": " << a[i]
+        << " vs " << b[i];
+      return ::testing::AssertionFailure() << o.str();
+    }
+  }
+  return ::testing::AssertionSuccess();
+}
+
+}  // namespace lazyboe::test
