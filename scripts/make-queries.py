@@ -3,6 +3,7 @@
 configurations of a sub-box of the sampling region, checked with `lazyboe-robot check`.
 
 usage: make-queries.py OUT.jsonl COUNT SEED [--env FILE] [--tolerance T] [--planners a,b]
+                      [--box central|region] [--robot FILE]
 """
 import argparse, csv, json, os, random, subprocess, sys, tempfile
 
@@ -13,10 +14,17 @@ p.add_argument("--tolerance", type=float, default=0.3)
 p.add_argument("--budget", type=float, default=2.0)
 p.add_argument("--planners", default="lazyboe,boe,rrt,sst")
 p.add_argument("--tool", default="build/bin/lazyboe-robot")
+p.add_argument("--robot", default="data/robots/panda.json")
+p.add_argument("--box", choices=["central", "region"], default="central",
+               help="central: the middle of the Panda's region, where a small demo bundle is "
+               "dense enough; region: the robot config's whole sampling region")
 a = p.parse_args()
-# The middle of the Panda's default region (joint 1..7), where a demo bundle is dense enough.
-lo = [-0.6, -0.1, -0.35, -2.35, -0.35, 1.55, 0.35]
-hi = [0.6, 0.5, 0.35, -1.65, 0.35, 2.25, 1.25]
+if a.box == "central":
+    lo = [-0.6, -0.1, -0.35, -2.35, -0.35, 1.55, 0.35]
+    hi = [0.6, 0.5, 0.35, -1.65, 0.35, 2.25, 1.25]
+else:
+    region = json.load(open(a.robot))["sampling_region"]
+    lo, hi = region["lower"], region["upper"]
 rng = random.Random(a.seed)
 with tempfile.TemporaryDirectory() as d:
     cand = [[round(rng.uniform(l, h), 4) for l, h in zip(lo, hi)] for _ in range(8 * a.count)]
@@ -24,7 +32,7 @@ with tempfile.TemporaryDirectory() as d:
     with open(inp, "w") as f:
         f.write(",".join(f"q{i}" for i in range(1, 8)) + "\n")
         f.writelines(",".join(map(str, q)) + "\n" for q in cand)
-    subprocess.run([a.tool, "check", "--env", a.env, "--in", inp, "--out", res], check=True,
+    subprocess.run([a.tool, "--robot", a.robot, "check", "--env", a.env, "--in", inp, "--out", res], check=True,
                    stderr=subprocess.DEVNULL)
     rows = list(csv.DictReader(open(res)))
 free = [q for q, r in zip(cand, rows)

@@ -138,17 +138,21 @@ class BundleSearch {
       if (s_.nodes()[v].expanded || dead(v)) continue;
       if (s_.in_goal(s_.nodes()[v].h) && !s_.nodes()[v].lazy) continue;  // already a solution
       if (prunable(v)) continue;
-      s_.nodes()[v].expanded = true;
-      const double radius = s_.nodes()[v].lazy ? theta_ / 2 : theta_;
-      ctx_.index->within(s_.nodes()[v].q.data(), radius, neighbours);
-      if (neighbours.empty() && s_.nodes()[v].lazy) {
+      const bool lazy_node = s_.nodes()[v].lazy;
+      ctx_.index->within(s_.nodes()[v].q.data(), lazy_node ? theta_ / 2 : theta_, neighbours);
+      if (neighbours.empty() && lazy_node) {
         // The lazy chain cannot go on (nothing starts within theta/2 of its stored end): it
-        // terminates, is simulated, and the node is expanded as a real one.
-        if (!realize(v)) continue;
-        ctx_.index->within(s_.nodes()[v].q.data(), theta_, neighbours);
+        // terminates and is simulated; the node goes back to the queue as a real one, keyed by
+        // its simulated heuristic (realize), and competes with the rest before its expansion.
+        realize(v);
+        continue;
       }
-      for (const auto& [e, d2] : neighbours) {
-        (void)d2;
+      s_.nodes()[v].expanded = true;
+      // Most promising edges first (heuristic at their stored end): the same edges are taken,
+      // but a goal reached in this expansion is reached sooner.
+      order_by_promise(neighbours, n);
+      for (const auto& [e, key] : neighbours) {
+        (void)key;
         if (s_.should_stop() || dead(v)) break;
         if (lazy_ && !exhaustive_) {
           const double p_select = (1 - b.p_collision(e)) * b.p_lazy_prop(e);
@@ -171,6 +175,13 @@ class BundleSearch {
 
  private:
   void push(int node) { open_.emplace(s_.nodes()[node].h, node); }
+
+  void order_by_promise(std::vector<std::pair<uint32_t, double>>& edges, int n) {
+    const BundleView& b = *ctx_.bundle;
+    for (auto& [e, key] : edges) key = s_.heuristic(row(b.qf(e), n));
+    std::stable_sort(edges.begin(), edges.end(),
+                     [](const auto& x, const auto& y) { return x.second < y.second; });
+  }
 
   // A node under a dead ancestor (a lazy chain that failed) is dead too.
   bool dead(int v) {
