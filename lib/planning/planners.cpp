@@ -249,10 +249,12 @@ class BundleSearch {
     const int id = s_.add(c);
     // SHOULD_TERMINATE_LAZY: the lazy path reaches the goal region (simulate it, the child
     // included), or the heuristic rises again (simulate the chain up to the parent, which was
-    // the best point of it; the child waits in the queue).
+    // the best point of it; the child waits in the queue). A tie counts as rising: an edge
+    // whose stored end lies within theta/2 of its own start can be taken again from that end,
+    // and a chain without progress would otherwise grow forever for free.
     if (s_.in_goal(c.h)) {
       realize(id);
-    } else if (c.h > s_.nodes()[v].h && s_.nodes()[v].lazy) {
+    } else if (c.h >= s_.nodes()[v].h && s_.nodes()[v].lazy) {
       if (realize(v)) push(id);
     } else {
       push(id);
