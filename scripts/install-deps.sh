@@ -9,8 +9,11 @@ packages=(
   nlohmann-json3-dev libnanoflann-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   python3 python3-jsonschema
+  # Optional for the build (lazyboe-bench skips what is missing, and says so), installed so
+  # that the demo and the tests cover OMPL's planners and the benchmark figures.
+  libompl-dev python3-matplotlib
 )
-# Extra packages a caller asks for (e.g. libompl-dev for the OMPL rows of the benchmark).
+# Extra packages a caller asks for.
 packages+=("$@")
 
 missing=()

@@ -209,7 +209,9 @@ TEST(Collision, DerivedAllowedPairsAreAdjacentLinks) {
   EXPECT_EQ(adjacent, 7);
   // Every derived pair is in the committed config.
   for (const LinkPairStats& p : result.pairs) {
-    if (!p.reason.empty()) EXPECT_TRUE(robot.is_allowed_pair(p.link_a, p.link_b));
+    if (!p.reason.empty()) {
+      EXPECT_TRUE(robot.is_allowed_pair(p.link_a, p.link_b));
+    }
   }
 }
 

@@ -10,33 +10,15 @@
 #include <iostream>
 #include <map>
 
-#include "bundle/builder.h"
-#include "bundle/bundle_view.h"
 #include "common/histogram.h"
 #include "io/query_io.h"
 #include "planning/planners.h"
+#include "planning/planning_session.h"
 #include "tool_main.h"
 
 namespace {
 
 using namespace lazyboe;
-using Clock = std::chrono::steady_clock;
-
-double resident_mib() {
-  std::ifstream status("/proc/self/status");
-  std::string key;
-  while (status >> key) {
-    if (key == "VmRSS:") {
-      double kib = 0;
-      status >> kib;
-      return kib / 1024;
-    }
-    std::string rest;
-    std::getline(status, rest);
-  }
-  return 0;
-}
-
 struct Outcome {
   std::string planner;
   bool success = false;
@@ -88,33 +70,23 @@ int main(int argc, char** argv) {
     } else if (trajectories != "none") {
       fail("--trajectories", "expected none, inline or csv");
     }
-    const auto t0 = Clock::now();
-    const BundleView bundle = BundleView::open(bundle_path, !no_mmap);
-    const BundleHeader& h = bundle.header();
-    const BundleScene scene = load_bundle_scene(h, robot_path, env_path);
-    const RobotModel& robot = scene.robot;
-    const CollisionModel collision = build_collision_model(robot, scene.env);
-    const BuildSettings settings = settings_from_header(h);
-    SimulationOptions options = settings.simulation;
-    options.sample_every = 0;
-    const Simulator sim(robot, collision, options);
-    const EdgeStartIndex index(bundle);
-    const double load_seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+    const PlanningSession session(bundle_path, !no_mmap, robot_path, env_path);
+    const BundleView& bundle = session.bundle;
+    const RobotModel& robot = session.scene.robot;
+    const Simulator& sim = session.sim;
     if (!quiet) {
       for (const std::string& w : bundle.warnings())
         std::fprintf(stderr, "lazyboe-query: warning: %s\n", w.c_str());
-      std::fprintf(stderr,
-                   "lazyboe-query: %s: %zu edges loaded in %.3f s (%s), resident memory %.0f MiB\n",
-                   bundle_path.c_str(), bundle.size(), load_seconds,
-                   bundle.memory_mapped() ? "memory-mapped" : "read into memory", resident_mib());
+      std::fprintf(
+          stderr, "lazyboe-query: %s: %zu edges loaded in %.3f s (%s), resident memory %.0f MiB\n",
+          bundle_path.c_str(), bundle.size(), session.load_seconds,
+          bundle.memory_mapped() ? "memory-mapped" : "read into memory", resident_memory_mib());
     }
 
     QueryDefaults defaults;
-    defaults.theta = bundle.has_perturbation() ? bundle.perturbation_theta() : h.design_theta;
-    defaults.params.sample_lower = settings.region_lower;
-    defaults.params.sample_upper = settings.region_upper;
-    defaults.params.command = settings.command;
-    const PlanningContext context{sim, &bundle, &index};
+    defaults.params = session.default_params();
+    defaults.theta = defaults.params.theta;
+    const PlanningContext context = session.context();
     const int sample_every =
         std::max(1, static_cast<int>(std::lround(sample_interval * robot.control_rate)));
 
@@ -221,7 +193,7 @@ int main(int argc, char** argv) {
       }
       if (errors)
         std::fprintf(stderr, "%zu queries had errors (see their \"error\" field)\n", errors);
-      std::fprintf(stderr, "resident memory %.0f MiB\n", resident_mib());
+      std::fprintf(stderr, "resident memory %.0f MiB\n", resident_memory_mib());
     }
     return 0;
   });

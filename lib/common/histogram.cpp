@@ -30,7 +30,13 @@ Quantiles quantiles(std::vector<double> v) {
   Quantiles q;
   if (v.empty()) return q;
   std::sort(v.begin(), v.end());
-  auto at = [&](double f) { return v[static_cast<size_t>(f * (v.size() - 1) + 0.5)]; };
+  // Linear interpolation between the closest ranks (numpy's default): the median of an even
+  // count is the mean of the middle two.
+  auto at = [&](double f) {
+    const double pos = f * (v.size() - 1);
+    const size_t lo = static_cast<size_t>(pos);
+    return lo + 1 < v.size() ? v[lo] + (pos - lo) * (v[lo + 1] - v[lo]) : v[lo];
+  };
   q.min = v.front();
   q.p10 = at(0.1);
   q.median = at(0.5);

@@ -5,6 +5,7 @@
 #include "common/error.h"
 #include "common/json_fields.h"
 #include "io/csv.h"
+#include "planning/ompl_planners.h"
 
 namespace lazyboe {
 namespace {
@@ -46,9 +47,11 @@ Query parse_query(const std::string& text, int line, const RobotModel& robot, co
   PlannerParams& p = q.problem.params;
   p = d.params;
   p.planner = root.has("planner") ? root.at("planner").string() : "lazyboe";
-  if (p.planner != "lazyboe" && p.planner != "boe" && p.planner != "rrt" && p.planner != "sst") {
-    root.at("planner").fail("unknown planner '" + p.planner +
-                            "' (expected lazyboe, boe, rrt or sst)");
+  if (p.planner != "lazyboe" && p.planner != "boe" && p.planner != "rrt" && p.planner != "sst" &&
+      !is_ompl_planner(p.planner)) {
+    root.at("planner").fail(
+        "unknown planner '" + p.planner +
+        "' (expected lazyboe, boe, rrt, sst, ompl-rrt, ompl-sst or ompl-kpiece)");
   }
   p.budget = root.has("budget") ? root.at("budget").positive() : d.budget;
   p.seed = root.has("seed") ? static_cast<uint64_t>(root.at("seed").integer()) : 1;

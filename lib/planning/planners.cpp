@@ -7,6 +7,7 @@
 #include <unordered_set>
 
 #include "common/error.h"
+#include "planning/ompl_planners.h"
 #include "sim/random.h"
 
 namespace lazyboe {
@@ -465,7 +466,9 @@ PlanResult plan(const PlanningContext& ctx, SimulatorWorkspace& ws,
     if (name == "rrt") p.params.stop_at_first = true;
     return TreeSearch(ctx, ws, p, name == "sst").run();
   }
-  fail("planner", "unknown planner '" + name + "' (expected lazyboe, boe, rrt or sst)");
+  if (is_ompl_planner(name)) return plan_ompl(ctx, ws, problem);
+  fail("planner", "unknown planner '" + name +
+                      "' (expected lazyboe, boe, rrt, sst, ompl-rrt, ompl-sst or ompl-kpiece)");
 }
 
 }  // namespace lazyboe

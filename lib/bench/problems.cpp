@@ -1,0 +1,90 @@
+#include "bench/problems.h"
+
+#include <cstdio>
+#include <fstream>
+
+#include "common/error.h"
+#include "sim/random.h"
+
+namespace lazyboe {
+namespace {
+
+JointVector valid_sample(const Simulator& sim, SimulatorWorkspace& ws, const JointVector& lower,
+                         const JointVector& upper, Random& rng) {
+  JointVector q(lower.size());
+  // The region of a usable bundle is mostly free; a million misses means it is not.
+  for (int attempt = 0; attempt < 1000000; ++attempt) {
+    for (int i = 0; i < q.size(); ++i) q[i] = rng.uniform(lower[i], upper[i]);
+    if (check_state(sim, ws, q) == RolloutStatus::Valid) return q;
+  }
+  fail("problems", "no collision-free configuration found in the sampling region");
+}
+
+nlohmann::json vector_json(const JointVectorRef& q) {
+  return std::vector<double>(q.data(), q.data() + q.size());
+}
+
+}  // namespace
+
+std::vector<BenchProblem> sample_problems(const Simulator& sim, SimulatorWorkspace& ws,
+                                          const JointVector& lower, const JointVector& upper,
+                                          int count, double tolerance, uint64_t seed) {
+  std::vector<BenchProblem> problems;
+  Random rng(seed, 0x9b0b1e75);  // a stream of its own: problems do not depend on planners
+  for (int k = 0; k < count; ++k) {
+    BenchProblem p;
+    p.id = "p" + std::to_string(k);
+    p.start = valid_sample(sim, ws, lower, upper, rng);
+    do {
+      p.goal.q = valid_sample(sim, ws, lower, upper, rng);
+    } while ((p.goal.q - p.start).norm() <= tolerance);
+    p.goal.kind = Goal::Kind::Joint;
+    p.goal.tolerance = tolerance;
+    problems.push_back(std::move(p));
+  }
+  return problems;
+}
+
+std::vector<BenchProblem> read_problems(const std::string& path, const Simulator& sim,
+                                        SimulatorWorkspace& ws, const QueryDefaults& defaults) {
+  std::ifstream in(path);
+  if (!in) fail(path, "cannot open file");
+  std::vector<BenchProblem> problems;
+  std::string text, id;
+  for (int line = 1; std::getline(in, text); ++line) {
+    if (text.find_first_not_of(" \t\r") == std::string::npos) continue;
+    try {
+      const Query q = parse_query(text, line, sim.robot, sim, ws, defaults, id);
+      problems.push_back({q.id, q.problem.start, q.problem.goal});
+    } catch (const Error& e) {
+      fail(path, e.what());
+    }
+  }
+  if (problems.empty()) fail(path, "no problems in the file");
+  return problems;
+}
+
+void write_problems(const std::string& path, const RobotModel& robot,
+                    const std::vector<BenchProblem>& problems) {
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream out(tmp);
+    if (!out) fail(path, "cannot write");
+    for (const BenchProblem& p : problems) {
+      nlohmann::json goal;
+      if (p.goal.kind == Goal::Kind::Joint) {
+        goal = {{"q", vector_json(p.goal.q)}, {"tolerance", p.goal.tolerance}};
+      } else {
+        goal = {{"position", {p.goal.position.x(), p.goal.position.y(), p.goal.position.z()}},
+                {"link", robot.links[p.goal.link].name},
+                {"tolerance", p.goal.tolerance}};
+      }
+      out << nlohmann::json{{"id", p.id}, {"start", vector_json(p.start)}, {"goal", goal}}.dump()
+          << "\n";
+    }
+    if (!out.flush()) fail(path, "cannot write");
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) fail(path, "cannot write");
+}
+
+}  // namespace lazyboe

@@ -1,0 +1,319 @@
+#include "bench/report.h"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include "common/error.h"
+#include "common/histogram.h"
+#include "common/statistics.h"
+
+namespace lazyboe {
+namespace {
+
+std::string quoted(const std::string& text) {
+  if (text.find_first_of(",\"\n\r") == std::string::npos) return text;
+  std::string out = "\"";
+  for (char c : text) {
+    if (c == '\n' || c == '\r') c = ' ';
+    if (c == '"') out += '"';
+    out += c;
+  }
+  return out + "\"";
+}
+
+// Splits one CSV line with RFC 4180 quoting; false for an unterminated quote.
+bool split_csv(const std::string& line, std::vector<std::string>& fields) {
+  fields.assign(1, "");
+  bool in_quotes = false;
+  for (size_t i = 0; i < line.size(); ++i) {
+    const char c = line[i];
+    if (in_quotes) {
+      if (c == '"' && i + 1 < line.size() && line[i + 1] == '"') {
+        fields.back() += '"';
+        ++i;
+      } else if (c == '"') {
+        in_quotes = false;
+      } else {
+        fields.back() += c;
+      }
+    } else if (c == '"') {
+      in_quotes = true;
+    } else if (c == ',') {
+      fields.emplace_back();
+    } else if (c != '\r') {
+      fields.back() += c;
+    }
+  }
+  return !in_quotes;
+}
+
+std::string number(double value, const char* format = "%.6g") {
+  if (!std::isfinite(value)) return "";
+  char text[64];
+  std::snprintf(text, sizeof text, format, value);
+  return text;
+}
+
+double parse_number(const std::string& text, const std::string& where, const std::string& column) {
+  if (text.empty()) return std::numeric_limits<double>::quiet_NaN();
+  size_t used = 0;
+  double value = 0;
+  try {
+    value = std::stod(text, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used != text.size()) fail(where, column + ": expected a number, got '" + text + "'");
+  return value;
+}
+
+}  // namespace
+
+const std::vector<std::string>& runs_csv_header() {
+  static const std::vector<std::string> header = {
+      "planner",   "problem",     "repeat", "seed",        "success",    "time_to_first_solution",
+      "best_cost", "n_solutions", "nodes",  "simulations", "lazy_edges", "collision_checks",
+      "budget",    "failure"};
+  return header;
+}
+
+std::string runs_csv_row(const RunRecord& r, const std::string& problem_id) {
+  std::ostringstream row;
+  row << quoted(r.planner) << ',' << quoted(problem_id) << ',' << r.repeat << ',' << r.seed << ','
+      << (r.success ? 1 : 0) << ',' << number(r.time_to_first_solution, "%.6f") << ','
+      << number(r.best_cost, "%.6f") << ',' << r.n_solutions << ',' << r.counters.nodes << ','
+      << r.counters.simulations << ',' << r.counters.lazy_edges << ','
+      << r.counters.collision_checks << ',' << number(r.budget) << ',' << quoted(r.failure);
+  return row.str();
+}
+
+PartialRunsFile::PartialRunsFile(const std::string& path) : path_(path) {
+  std::ifstream existing(path);
+  const bool fresh = !existing || existing.peek() == std::ifstream::traits_type::eof();
+  existing.close();
+  file_ = std::fopen(path.c_str(), "a");
+  if (!file_) fail(path, "cannot write");
+  if (fresh) {
+    std::string header;
+    for (const std::string& c : runs_csv_header()) header += (header.empty() ? "" : ",") + c;
+    std::fprintf(file_, "%s\n", header.c_str());
+    std::fflush(file_);
+  }
+}
+
+PartialRunsFile::~PartialRunsFile() {
+  if (file_) std::fclose(file_);
+}
+
+void PartialRunsFile::append(const RunRecord& r, const std::string& problem_id) {
+  const std::string row = runs_csv_row(r, problem_id) + "\n";
+  if (std::fputs(row.c_str(), file_) < 0 || std::fflush(file_) != 0) fail(path_, "cannot write");
+}
+
+std::vector<RunRecord> read_runs_csv(const std::string& path,
+                                     const std::vector<std::string>& problem_ids) {
+  std::ifstream in(path);
+  if (!in) fail(path, "cannot open file");
+  std::vector<std::string> lines;
+  for (std::string text; std::getline(in, text);) lines.push_back(text);
+  const bool complete_last_line = [&] {
+    std::ifstream raw(path, std::ios::binary | std::ios::ate);
+    if (raw.tellg() <= 0) return true;
+    raw.seekg(-1, std::ios::end);
+    return raw.get() == '\n';
+  }();
+  std::vector<std::string> fields;
+  const std::vector<std::string>& header = runs_csv_header();
+  if (lines.empty() || !split_csv(lines[0], fields) || fields != header) {
+    fail(path + ": line 1", "expected the runs.csv header");
+  }
+  std::map<std::string, int> index_of;
+  for (size_t k = 0; k < problem_ids.size(); ++k) index_of[problem_ids[k]] = static_cast<int>(k);
+  std::vector<RunRecord> runs;
+  for (size_t k = 1; k < lines.size(); ++k) {
+    const std::string where = path + ": line " + std::to_string(k + 1);
+    const bool torn = k + 1 == lines.size() && !complete_last_line;
+    if (!split_csv(lines[k], fields) || fields.size() != header.size()) {
+      if (torn) break;  // the write an interruption cut short
+      fail(where, "expected " + std::to_string(header.size()) + " fields");
+    }
+    if (torn) break;
+    RunRecord r;
+    r.planner = fields[0];
+    const auto problem = index_of.find(fields[1]);
+    if (problem == index_of.end()) fail(where, "problem: '" + fields[1] + "' is not in the study");
+    r.problem = problem->second;
+    r.repeat = static_cast<int>(parse_number(fields[2], where, "repeat"));
+    r.seed = static_cast<uint64_t>(std::stoull(fields[3].empty() ? "0" : fields[3]));
+    r.success = parse_number(fields[4], where, "success") == 1;
+    r.time_to_first_solution = parse_number(fields[5], where, "time_to_first_solution");
+    r.best_cost = parse_number(fields[6], where, "best_cost");
+    r.n_solutions = static_cast<int>(parse_number(fields[7], where, "n_solutions"));
+    r.counters.nodes = static_cast<uint64_t>(parse_number(fields[8], where, "nodes"));
+    r.counters.simulations = static_cast<uint64_t>(parse_number(fields[9], where, "simulations"));
+    r.counters.lazy_edges = static_cast<uint64_t>(parse_number(fields[10], where, "lazy_edges"));
+    r.counters.collision_checks =
+        static_cast<uint64_t>(parse_number(fields[11], where, "collision_checks"));
+    r.budget = parse_number(fields[12], where, "budget");
+    r.failure = fields[13];
+    runs.push_back(std::move(r));
+  }
+  return runs;
+}
+
+void write_runs_csv(const std::string& path, const std::vector<RunRecord>& runs,
+                    const std::vector<std::string>& problem_ids) {
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream out(tmp);
+    if (!out) fail(path, "cannot write");
+    std::string header;
+    for (const std::string& c : runs_csv_header()) header += (header.empty() ? "" : ",") + c;
+    out << header << "\n";
+    for (const RunRecord& r : runs) out << runs_csv_row(r, problem_ids.at(r.problem)) << "\n";
+    if (!out.flush()) fail(path, "cannot write");
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) fail(path, "cannot write");
+}
+
+namespace {
+
+struct PlannerStats {
+  size_t runs = 0, successes = 0;
+  std::vector<double> ttfs, cost, solutions, simulations;
+};
+
+std::string fixed(double value, int digits) {
+  if (!std::isfinite(value)) return "-";
+  char text[64];
+  std::snprintf(text, sizeof text, "%.*f", digits, value);
+  return text;
+}
+
+double median_of(const std::vector<double>& v) {
+  return v.empty() ? std::numeric_limits<double>::quiet_NaN() : quantiles(v).median;
+}
+double mean_of(const std::vector<double>& v) {
+  return v.empty() ? std::numeric_limits<double>::quiet_NaN() : quantiles(v).mean;
+}
+
+std::string test_cell(const std::vector<double>& lazy, const std::vector<double>& other) {
+  if (lazy.empty() || other.empty()) return "n/a";
+  const MannWhitney t = mann_whitney_u(lazy, other);
+  return "U = " + fixed(t.u1, 1) + ", p = " + format_p_value(t.p) + " " + significance_mark(t.p);
+}
+
+}  // namespace
+
+std::string summary_markdown(const StudyInfo& info, const std::vector<PlannerSpec>& specs,
+                             const std::vector<RunRecord>& runs) {
+  std::map<std::string, PlannerStats> stats;
+  for (const RunRecord& r : runs) {
+    PlannerStats& s = stats[r.planner];
+    ++s.runs;
+    s.solutions.push_back(r.n_solutions);
+    s.simulations.push_back(static_cast<double>(r.counters.simulations));
+    if (!r.success) continue;
+    ++s.successes;
+    s.ttfs.push_back(r.time_to_first_solution);
+    s.cost.push_back(r.best_cost);
+  }
+  auto rate = [](const PlannerStats& s) {
+    return s.runs ? static_cast<double>(s.successes) / s.runs
+                  : std::numeric_limits<double>::quiet_NaN();
+  };
+
+  std::ostringstream md;
+  md << "# lazyboe-bench summary\n\n";
+  md << "- Bundle: `" << info.bundle << "` (" << info.edges << " edges), robot `" << info.robot
+     << "`, environment `" << info.environment << "`\n";
+  md << "- Problems: " << info.problems << " (" << info.problems_source << "), repeats "
+     << info.repeats << ", budget " << fixed(info.budget, 1) << " s per run, study seed "
+     << info.seed << ", " << info.jobs << " run(s) in parallel\n";
+  md << "- Machine: " << info.machine << "\n";
+  md << "- Command: `" << info.command_line << "`\n\n";
+  md << "Time to first solution and final cost are over the successful runs; the number of "
+        "solutions is over all runs (0 for a failure). A run succeeds when it returns a path "
+        "that passes the re-simulation from the exact start with every check.\n\n";
+
+  md << "## Results\n\n";
+  md << "| planner | runs | success | median TTFS (s) | mean TTFS (s) | median cost (rad) | "
+        "mean cost (rad) | mean solutions | median simulations |\n";
+  md << "|---|---|---|---|---|---|---|---|---|\n";
+  for (const PlannerSpec& spec : specs) {
+    if (!spec.available) {
+      md << "| " << spec.name << " | skipped: " << spec.unavailable_reason << " | | | | | | | |\n";
+      continue;
+    }
+    const PlannerStats& s = stats[spec.name];
+    md << "| " << spec.name << " | " << s.runs << " | " << fixed(100 * rate(s), 0) << "% | "
+       << fixed(median_of(s.ttfs), 3) << " | " << fixed(mean_of(s.ttfs), 3) << " | "
+       << fixed(median_of(s.cost), 2) << " | " << fixed(mean_of(s.cost), 2) << " | "
+       << fixed(mean_of(s.solutions), 2) << " | " << fixed(median_of(s.simulations), 0) << " |\n";
+  }
+
+  const bool have_lazy = stats.count("lazyboe") && stats["lazyboe"].runs > 0;
+  if (have_lazy) {
+    const PlannerStats& lazy = stats["lazyboe"];
+    md << "\n## LazyBoE against each baseline\n\n";
+    md << "Mann-Whitney U test, two-sided (U of LazyBoE's sample); marks: ns p > 0.05, "
+          "* p <= 0.05, ** p <= 0.01, *** p <= 0.001, **** p <= 0.0001.\n\n";
+    md << "| baseline | time to first solution | final cost | number of solutions |\n";
+    md << "|---|---|---|---|\n";
+    for (const PlannerSpec& spec : specs) {
+      if (spec.name == "lazyboe" || !spec.available) continue;
+      const PlannerStats& s = stats[spec.name];
+      md << "| " << spec.name << " | " << test_cell(lazy.ttfs, s.ttfs) << " | "
+         << test_cell(lazy.cost, s.cost) << " | " << test_cell(lazy.solutions, s.solutions)
+         << " |\n";
+    }
+
+    md << "\n## Targets\n\n";
+    auto verdict = [](bool ok) { return ok ? "**met**" : "**not met**"; };
+    const double lazy_median = median_of(lazy.ttfs);
+    if (stats.count("ompl-sst") && stats["ompl-sst"].runs > 0) {
+      const double sst_median = median_of(stats["ompl-sst"].ttfs);
+      const double ratio = sst_median / lazy_median;
+      md << "- LazyBoE's median time to first solution at least 10x lower than OMPL's SST: "
+         << fixed(lazy_median, 3) << " s against " << fixed(sst_median, 3) << " s, "
+         << fixed(ratio, 1) << "x: " << verdict(std::isfinite(ratio) && ratio >= 10) << "\n";
+    } else {
+      md << "- LazyBoE against OMPL's SST: not measured (ompl-sst not in this study)\n";
+    }
+    bool best = true;
+    std::string worse;
+    for (const PlannerSpec& spec : specs) {
+      if (spec.name == "lazyboe" || !spec.available || !stats[spec.name].runs) continue;
+      if (rate(stats[spec.name]) > rate(lazy)) {
+        best = false;
+        worse += (worse.empty() ? "" : ", ") + spec.name;
+      }
+    }
+    md << "- Success rate at least every baseline's and at least 92%: "
+       << fixed(100 * rate(lazy), 0) << "%" << (best ? "" : " (" + worse + " higher)") << ": "
+       << verdict(best && rate(lazy) >= 0.92) << "\n";
+    if (stats.count("boe") && stats["boe"].runs > 0) {
+      const double boe_cost = median_of(stats["boe"].cost), lazy_cost = median_of(lazy.cost);
+      md << "- Final cost no worse than BoE's (median): " << fixed(lazy_cost, 2) << " rad against "
+         << fixed(boe_cost, 2)
+         << " rad: " << verdict(std::isfinite(lazy_cost) && lazy_cost <= boe_cost) << "\n";
+    } else {
+      md << "- Final cost against BoE: not measured (boe not in this study)\n";
+    }
+  }
+
+  bool any_skipped = false;
+  for (const PlannerSpec& spec : specs) any_skipped |= !spec.available;
+  if (any_skipped) {
+    md << "\n## Skipped planners\n\n";
+    for (const PlannerSpec& spec : specs) {
+      if (!spec.available) md << "- " << spec.name << ": " << spec.unavailable_reason << "\n";
+    }
+  }
+  return md.str();
+}
+
+}  // namespace lazyboe

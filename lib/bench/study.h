@@ -1,0 +1,72 @@
+// A benchmark study: every planner on every problem, repeated with different seeds, each run
+// with the same wall-clock budget; the record of each run is what the paper reports (success,
+// time to first solution, final cost, number of solutions) plus the planner's counters.
+#pragma once
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "bench/problems.h"
+
+namespace lazyboe {
+
+struct PlannerSpec {
+  std::string name;      // as in runs.csv: lazyboe, boe, rrt, sst-0.5x, ..., ompl-sst
+  PlannerParams params;  // planner (as plan() knows it) and its parameters
+  bool available = true;
+  std::string unavailable_reason;
+};
+
+// The study's planners: "all" or a comma-separated list of lazyboe, boe, rrt, sst-0.5x, sst-1x,
+// sst-2x (the paper's pruning-to-selection ratios; "sst" means all three), ompl-rrt, ompl-sst,
+// ompl-kpiece. OMPL planners in a build without OMPL are kept, marked unavailable. Throws
+// Error("--planners", ...) for an unknown name.
+std::vector<PlannerSpec> planner_specs(const std::string& list, const PlannerParams& defaults);
+
+struct RunRecord {
+  std::string planner;
+  int problem = 0;  // index into the study's problems
+  int repeat = 0;
+  uint64_t seed = 0;
+  bool success = false;
+  double time_to_first_solution = std::numeric_limits<double>::quiet_NaN();  // s
+  double best_cost = std::numeric_limits<double>::quiet_NaN();  // arc length, rad (re-simulated)
+  int n_solutions = 0;
+  PlannerCounters counters;
+  double budget = 0;
+  std::string failure;  // why there is no solution, or the error
+};
+
+// The seed of a (problem, repeat) run: the same for every planner, different across repeats.
+uint64_t run_seed(uint64_t study_seed, int problem, int repeat);
+
+// One run. The best path is re-simulated from the exact start with every check
+// (realize_path); its cost is the reported cost, and a path that fails the check is reported
+// as a failed run with the reason (it would be a planner bug).
+RunRecord run_planner(const PlanningContext& context, SimulatorWorkspace& ws,
+                      const PlannerSpec& planner, const BenchProblem& problem, int problem_index,
+                      int repeat, uint64_t seed, double budget);
+
+struct StudyTask {
+  int planner = 0;  // index into the specs
+  int problem = 0;
+  int repeat = 0;
+};
+
+struct StudyControl {
+  int jobs = 1;                          // runs in parallel (one workspace each)
+  std::function<bool()> stop_requested;  // polled before each run starts
+  // Called for each finished run, one at a time (under a lock), in completion order.
+  std::function<void(const RunRecord&, size_t finished, size_t total)> on_run;
+};
+
+// Runs `tasks`; returns the records of the runs that finished, in task order. Runs in progress
+// when a stop is requested finish (within their budget); no new run starts.
+std::vector<RunRecord> run_study(const PlanningContext& context,
+                                 const std::vector<PlannerSpec>& planners,
+                                 const std::vector<BenchProblem>& problems,
+                                 const std::vector<StudyTask>& tasks, double budget,
+                                 uint64_t study_seed, const StudyControl& control);
+
+}  // namespace lazyboe

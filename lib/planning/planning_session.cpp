@@ -1,0 +1,57 @@
+#include "planning/planning_session.h"
+
+#include <chrono>
+#include <fstream>
+
+namespace lazyboe {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+SimulationOptions unsampled(SimulationOptions options) {
+  options.sample_every = 0;
+  return options;
+}
+
+}  // namespace
+
+PlanningSession::PlanningSession(const std::string& bundle_path, bool memory_map,
+                                 const std::string& robot_path, const std::string& env_path)
+    : started_(Clock::now()),
+      bundle(BundleView::open(bundle_path, memory_map)),
+      scene(load_bundle_scene(bundle.header(), robot_path, env_path)),
+      collision(build_collision_model(scene.robot, scene.env)),
+      settings(settings_from_header(bundle.header())),
+      sim(scene.robot, collision, unsampled(settings.simulation)),
+      index(bundle),
+      load_seconds(std::chrono::duration<double>(Clock::now() - started_).count()) {}
+
+double PlanningSession::default_theta() const {
+  return bundle.has_perturbation() ? bundle.perturbation_theta() : bundle.header().design_theta;
+}
+
+PlannerParams PlanningSession::default_params() const {
+  PlannerParams p;
+  p.theta = default_theta();
+  p.sample_lower = settings.region_lower;
+  p.sample_upper = settings.region_upper;
+  p.command = settings.command;
+  return p;
+}
+
+double resident_memory_mib() {
+  std::ifstream status("/proc/self/status");
+  std::string key;
+  while (status >> key) {
+    if (key == "VmRSS:") {
+      double kib = 0;
+      status >> kib;
+      return kib / 1024;
+    }
+    std::string rest;
+    std::getline(status, rest);
+  }
+  return 0;
+}
+
+}  // namespace lazyboe

@@ -1,0 +1,51 @@
+// Everything one process needs to plan on a bundle, built once and read-only afterwards (the
+// Pinocchio "model" side; each thread brings its own SimulatorWorkspace): the bundle (memory-
+// mapped, or read), its robot and environment (checked against the identity stored in the
+// bundle), the collision model, one simulator with the bundle's settings, and the k-d tree
+// over the edge starts. Shared by lazyboe-query and lazyboe-bench.
+#pragma once
+
+#include <chrono>
+#include <string>
+
+#include "bundle/builder.h"
+#include "bundle/bundle_view.h"
+#include "collision/collision_model.h"
+#include "planning/neighbour_index.h"
+#include "planning/problem.h"
+
+namespace lazyboe {
+
+class PlanningSession {
+ public:
+  // Throws Error for a missing or corrupt bundle, or robot/environment files that do not match
+  // it. Empty robot_path/env_path: the files named in the bundle.
+  PlanningSession(const std::string& bundle_path, bool memory_map, const std::string& robot_path,
+                  const std::string& env_path);
+  PlanningSession(const PlanningSession&) = delete;  // the simulator refers to members
+  PlanningSession& operator=(const PlanningSession&) = delete;
+
+ private:
+  const std::chrono::steady_clock::time_point started_;  // first: times the members below
+
+ public:
+  const BundleView bundle;
+  const BundleScene scene;
+  const CollisionModel collision;
+  const BuildSettings settings;  // the bundle's simulation, command and region settings
+  const Simulator sim;           // trajectories are not sampled (sample_every = 0)
+  const EdgeStartIndex index;
+  const double load_seconds;  // wall time of everything above
+
+  PlanningContext context() const { return {sim, &bundle, &index}; }
+  // theta of the perturbation analysis, or the bundle's design theta without one.
+  double default_theta() const;
+  // Planner parameters that come from the bundle: theta, the sampling box and command family
+  // of RRT/SST.
+  PlannerParams default_params() const;
+};
+
+// Resident memory of this process (VmRSS), MiB; 0 where /proc is not available.
+double resident_memory_mib();
+
+}  // namespace lazyboe

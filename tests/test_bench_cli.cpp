@@ -1,0 +1,250 @@
+// lazyboe-bench end to end on one small bundle built here with the real tools: a tiny study
+// (2 problems, 1 s budget) produces every file, with consistent rows; OMPL rows are run or
+// reported as skipped, never silently missing; the problems file repeats a study exactly; an
+// interrupted study (partial rows, a torn last line, or SIGINT) resumes without redoing runs;
+// bad input is a one-line error that leaves earlier results untouched.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <thread>
+
+#include "cli_util.h"
+#include "planning/ompl_planners.h"
+
+namespace lazyboe::test {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr const char* kRegion = "-0.3:0.3,0.0:0.5,-0.3:0.3,-2.3:-1.7,-0.3:0.3,1.6:2.2,0.5:1.1";
+
+// A 1500-edge bundle in a small region with a p = 2 perturbation analysis, once per process.
+const std::string& bundle() {
+  static const std::string path = [] {
+    const std::string dir = fresh_dir("bench-bundle"), out = dir + "/bundle.h5";
+    const CommandResult b =
+        run("timeout -s KILL 300 " + quote(tool_path("lazyboe-build")) + " --out " + quote(out) +
+            " --edges 1500 --region=" + kRegion + " --theta 0.45 --quiet");
+    if (b.exit_code != 0) throw std::runtime_error("lazyboe-build failed: " + describe(b));
+    const CommandResult p = run("timeout -s KILL 300 " + quote(tool_path("lazyboe-perturb")) +
+                                " --bundle " + quote(out) + " --perturbations 2 --quiet");
+    if (p.exit_code != 0) throw std::runtime_error("lazyboe-perturb failed: " + describe(p));
+    return out;
+  }();
+  return path;
+}
+
+CommandResult bench(const std::string& args) {
+  return run("timeout -s KILL 300 " + quote(tool_path("lazyboe-bench")) + " --bundle " +
+             quote(bundle()) + " " + args);
+}
+
+std::vector<std::string> lines_of(const std::string& text) {
+  std::vector<std::string> out;
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);) out.push_back(line);
+  return out;
+}
+
+std::vector<std::string> fields_of(const std::string& line) {
+  std::vector<std::string> out(1);
+  bool quoted = false;
+  for (char c : line) {
+    if (c == '"') {
+      quoted = !quoted;
+    } else if (c == ',' && !quoted) {
+      out.emplace_back();
+    } else {
+      out.back() += c;
+    }
+  }
+  return out;
+}
+
+const std::string kHeader =
+    "planner,problem,repeat,seed,success,time_to_first_solution,best_cost,n_solutions,nodes,"
+    "simulations,lazy_edges,collision_checks,budget,failure";
+
+bool matplotlib_installed() {
+  return std::system("/usr/bin/python3 -c 'import matplotlib' > /dev/null 2>&1") == 0;
+}
+
+// Every row is self-consistent: a success has a time within the budget, a positive cost and at
+// least one solution; a failure has a reason and no time or cost.
+void expect_consistent_rows(const std::vector<std::string>& rows, double budget) {
+  for (size_t k = 1; k < rows.size(); ++k) {
+    const std::vector<std::string> f = fields_of(rows[k]);
+    ASSERT_EQ(f.size(), 14u) << rows[k];
+    EXPECT_GT(std::stoull(f[9]), 0u) << "a run that simulated nothing: " << rows[k];
+    if (f[4] == "1") {
+      EXPECT_LE(std::stod(f[5]), budget + 0.5) << rows[k];
+      EXPECT_GT(std::stod(f[6]), 0) << rows[k];
+      EXPECT_GE(std::stoi(f[7]), 1) << rows[k];
+    } else {
+      ASSERT_EQ(f[4], "0") << rows[k];
+      EXPECT_TRUE(f[5].empty() && f[6].empty()) << rows[k];
+      EXPECT_FALSE(f[13].empty()) << "a failure without a reason: " << rows[k];
+    }
+  }
+}
+
+TEST(BenchCli, TinyStudyWritesEveryFileWithConsistentRows) {
+  const std::string dir = fresh_dir("study");
+  const CommandResult r = bench("--problems 2 --budget 1 --jobs 2 --seed 3 --out " + quote(dir));
+  ASSERT_EQ(r.exit_code, 0) << describe(r);
+
+  const std::vector<std::string> problems = lines_of(read_file(dir + "/problems.jsonl"));
+  ASSERT_EQ(problems.size(), 2u);
+  for (const std::string& line : problems) {
+    const nlohmann::json q = nlohmann::json::parse(line);
+    EXPECT_EQ(q["start"].size(), 7u);
+    EXPECT_EQ(q["goal"]["q"].size(), 7u);
+    EXPECT_DOUBLE_EQ(q["goal"]["tolerance"].get<double>(), 0.45);  // the bundle's theta
+  }
+
+  const std::vector<std::string> rows = lines_of(read_file(dir + "/runs.csv"));
+  ASSERT_FALSE(rows.empty());
+  EXPECT_EQ(rows[0], kHeader);
+  const std::vector<std::string> ours = {"lazyboe", "boe", "rrt", "sst-0.5x", "sst-1x", "sst-2x"};
+  const std::vector<std::string> ompl = {"ompl-rrt", "ompl-sst", "ompl-kpiece"};
+  const size_t planners = ours.size() + (ompl_available() ? ompl.size() : 0);
+  ASSERT_EQ(rows.size(), 1 + 2 * planners) << read_file(dir + "/runs.csv");
+  expect_consistent_rows(rows, 1.0);
+  size_t lazy_edges = 0;
+  for (size_t k = 1; k < rows.size(); ++k) {
+    const std::vector<std::string> f = fields_of(rows[k]);
+    if (f[0] == "lazyboe") lazy_edges += std::stoull(f[10]);
+    if (f[0] != "lazyboe") {
+      EXPECT_EQ(f[10], "0") << "only LazyBoE takes lazy edges: " << rows[k];
+    }
+  }
+  EXPECT_GT(lazy_edges, 0u);
+
+  const std::string summary = read_file(dir + "/summary.md");
+  for (const std::string& name : ours) EXPECT_TRUE(contains(summary, "| " + name + " |")) << name;
+  for (const std::string& name : ompl) {
+    EXPECT_TRUE(contains(summary, "| " + name + " |")) << name;
+    if (!ompl_available()) {
+      EXPECT_TRUE(contains(summary, "- " + name + ": built without OMPL")) << summary;
+      EXPECT_TRUE(contains(r.err, "skipping " + name)) << r.err;
+    }
+  }
+  EXPECT_TRUE(contains(summary, "Mann-Whitney U")) << summary;
+  EXPECT_TRUE(contains(summary, "## Targets")) << summary;
+  EXPECT_TRUE(fs::exists(dir + "/study.json"));
+  EXPECT_FALSE(fs::exists(dir + "/runs.partial.csv"));
+  for (const char* figure :
+       {"time_to_first_solution.png", "final_cost.png", "n_solutions.png", "success_rate.png"}) {
+    if (matplotlib_installed()) {
+      EXPECT_GT(fs::file_size(dir + "/" + figure), 1000u) << figure;
+    } else {
+      EXPECT_TRUE(contains(r.err, "figures skipped")) << r.err;
+    }
+  }
+
+  // The problems file repeats the study's problems exactly.
+  const std::string again = fresh_dir("study-again");
+  const CommandResult r2 =
+      bench("--problems-file " + quote(dir + "/problems.jsonl") +
+            " --planners rrt --budget 0.5 --no-figures --quiet --out " + quote(again));
+  ASSERT_EQ(r2.exit_code, 0) << describe(r2);
+  EXPECT_EQ(read_file(again + "/problems.jsonl"), read_file(dir + "/problems.jsonl"));
+  EXPECT_EQ(lines_of(read_file(again + "/runs.csv")).size(), 3u);
+
+  // An earlier study is not overwritten without --force.
+  const auto before = snapshot(dir);
+  expect_one_line_error(bench("--problems 2 --budget 1 --out " + quote(dir)),
+                        {dir, "--resume", "--force"});
+  EXPECT_EQ(snapshot(dir), before);
+}
+
+TEST(BenchCli, ResumeRunsOnlyWhatIsMissingAndIgnoresATornLine) {
+  const std::string dir = fresh_dir("resume");
+  const std::string args =
+      "--problems 2 --planners rrt,boe --budget 0.5 --no-figures --out " + quote(dir);
+  const CommandResult first = bench(args + " --quiet");
+  ASSERT_EQ(first.exit_code, 0) << describe(first);
+  const std::vector<std::string> rows = lines_of(read_file(dir + "/runs.csv"));
+  ASSERT_EQ(rows.size(), 5u);
+
+  // As if interrupted after two runs, in the middle of writing the third.
+  fs::remove(dir + "/runs.csv");
+  write_bytes(dir + "/runs.partial.csv", rows[0] + "\n" + rows[1] + "\n" + rows[3] + "\n" +
+                                             rows[2].substr(0, rows[2].size() / 2));
+  const CommandResult resumed = bench(args + " --resume");
+  ASSERT_EQ(resumed.exit_code, 0) << describe(resumed);
+  EXPECT_TRUE(contains(resumed.err, "2 runs to do (2 done)")) << resumed.err;
+  const std::vector<std::string> after = lines_of(read_file(dir + "/runs.csv"));
+  ASSERT_EQ(after.size(), 5u);
+  EXPECT_EQ(after[1], rows[1]);  // kept as saved, not run again
+  EXPECT_EQ(after[3], rows[3]);
+  EXPECT_EQ(fields_of(after[2])[0], fields_of(rows[2])[0]);
+  expect_consistent_rows(after, 0.5);
+
+  // Resuming with other parameters is refused, and changes nothing.
+  const auto before = snapshot(dir);
+  expect_one_line_error(
+      bench("--problems 2 --planners rrt,boe --budget 2 --out " + quote(dir) + " --resume"),
+      {"study.json", "other parameters"});
+  EXPECT_EQ(snapshot(dir), before);
+}
+
+TEST(BenchCli, InterruptKeepsFinishedRunsForResume) {
+  const std::string dir = fresh_dir("interrupt");
+  const std::string command = quote(tool_path("lazyboe-bench")) + " --bundle " + quote(bundle()) +
+                              " --problems 3 --planners boe,rrt --budget 2 --no-figures --quiet "
+                              "--out " +
+                              quote(dir);
+  const pid_t pid = fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    execl("/bin/sh", "sh", "-c", ("exec " + command).c_str(), static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  // Wait until the first run has finished (its row is in the partial file), then interrupt.
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (std::chrono::steady_clock::now() < deadline &&
+         lines_of(fs::exists(dir + "/runs.partial.csv") ? read_file(dir + "/runs.partial.csv") : "")
+                 .size() < 2) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  kill(pid, SIGINT);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 130);
+  EXPECT_FALSE(fs::exists(dir + "/runs.csv"));
+  const size_t saved = lines_of(read_file(dir + "/runs.partial.csv")).size() - 1;
+  EXPECT_GE(saved, 1u);
+  EXPECT_LT(saved, 6u);
+
+  const CommandResult resumed = run(command + " --resume");
+  ASSERT_EQ(resumed.exit_code, 0) << describe(resumed);
+  EXPECT_EQ(lines_of(read_file(dir + "/runs.csv")).size(), 7u);
+  EXPECT_FALSE(fs::exists(dir + "/runs.partial.csv"));
+}
+
+TEST(BenchCli, BadInputIsOneLineError) {
+  const std::string dir = fresh_dir("bad");
+  expect_one_line_error(bench("--planners lazyboe,foo --out " + quote(dir)), {"--planners", "foo"});
+  expect_one_line_error(bench("--planners rrt,rrt --out " + quote(dir)), {"--planners", "twice"});
+  expect_one_line_error(bench("--budget 0 --out " + quote(dir)), {"--budget"});
+  expect_one_line_error(bench("--out " + quote(dir) + " --resume"), {"study.json", "no study"});
+  write_bytes(dir + "/bad.jsonl", "{\"id\": \"a\", \"start\": [0, 0]}\n");
+  expect_one_line_error(bench("--problems-file " + quote(dir + "/bad.jsonl") +
+                              " --planners rrt --quiet --out " + quote(dir + "/out")),
+                        {"bad.jsonl", "line 1"});
+  expect_one_line_error(run(quote(tool_path("lazyboe-bench")) + " --bundle " +
+                            quote(dir + "/missing.h5") + " --out " + quote(dir + "/out")),
+                        {"missing.h5"});
+}
+
+}  // namespace
+}  // namespace lazyboe::test
