@@ -12,11 +12,13 @@
 #include <string>
 #include <vector>
 
+#include "bundle/builder.h"
 #include "collision/collision_model.h"
 #include "collision/environment.h"
 #include "robot/dynamics.h"
 #include "robot/kinematics.h"
 #include "robot/robot_model.h"
+#include "sim/simulator.h"
 
 namespace {
 
@@ -168,6 +170,74 @@ void BM_ForwardDynamics(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations());
 }
 BENCHMARK(BM_ForwardDynamics);
+
+// What one simulated tick spends in dynamics: the shared terms (joint poses, mass matrix and its
+// factor, gravity, velocity terms with friction) and the accelerations for one torque.
+// noinline: callgrind --toggle-collect='*run_dynamics_tick*' isolates the loop.
+[[gnu::noinline]] void run_dynamics_tick(benchmark::State& state, const StatePool& p) {
+  const RobotModel& m = robot();
+  RobotData data(m);
+  std::size_t k = 0;
+  for (auto _ : state) {
+    dynamics_terms(m, data, p.q[k], p.dq[k]);
+    const JointVector& ddq = forward_dynamics_from_terms(data, p.tau[k]);
+    benchmark::DoNotOptimize(ddq);
+    k = (k + 1) & kPoolMask;
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+void BM_DynamicsTick(benchmark::State& state) { run_dynamics_tick(state, state_pool()); }
+BENCHMARK(BM_DynamicsTick);
+
+// Whole rollouts as the bundle builder runs them (default settings: semi-implicit Euler at the
+// control rate, table.json), replayed from a fixed pool of generated edges. Items are simulated
+// ticks, so items_per_second is ticks per second and instructions per tick is the callgrind
+// total of run_simulate divided by the "ticks" counter times the iterations.
+struct EdgePool {
+  Simulator sim;
+  std::vector<EdgeAttempt> edges;
+};
+
+const EdgePool& edge_pool() {
+  static const EdgePool pool = [] {
+    const RobotModel& m = robot();
+    static const CollisionModel model = table_scene().model;
+    BuildSettings settings;
+    settings.region_lower = m.region_lower;
+    settings.region_upper = m.region_upper;
+    settings.seed = kSeed;
+    settings.simulation.integrator = Integrator::SemiImplicitEuler;  // lazyboe-build's default
+    EdgePool p{Simulator(m, model, settings.simulation), {}};
+    SimulatorWorkspace ws(p.sim);
+    for (uint64_t a = 0; p.edges.size() < 64; ++a) {
+      EdgeAttempt e;
+      generate_edge(p.sim, ws, settings, a, e);
+      if (e.valid()) p.edges.push_back(std::move(e));
+    }
+    return p;
+  }();
+  return pool;
+}
+
+[[gnu::noinline]] void run_simulate(benchmark::State& state, const EdgePool& pool) {
+  const int dof = robot().dof;
+  SimulatorWorkspace ws(pool.sim);
+  std::size_t k = 0;
+  int64_t ticks = 0;
+  for (auto _ : state) {
+    const EdgeAttempt& e = pool.edges[k];
+    const CommandProfile profile{e.knots.data(), static_cast<int>(e.knots.size() / dof), dof,
+                                 e.command_duration};
+    const RolloutResult r = simulate(pool.sim, ws, e.q0, profile);
+    benchmark::DoNotOptimize(r.qf);
+    ticks += r.ticks;
+    k = (k + 1) % pool.edges.size();
+  }
+  state.SetItemsProcessed(ticks);
+  state.counters["ticks"] = static_cast<double>(ticks) / static_cast<double>(state.iterations());
+}
+void BM_SimulateEdge(benchmark::State& state) { run_simulate(state, edge_pool()); }
+BENCHMARK(BM_SimulateEdge);
 
 // ---- Collision: forward kinematics + transform update + self and environment check -----------
 

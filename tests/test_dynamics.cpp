@@ -315,3 +315,110 @@ TEST(Dynamics, SharedTermsMatchSeparateAlgorithms) {
 
 }  // namespace
 }  // namespace lazyboe
+
+namespace lazyboe {
+namespace {
+
+// The Panda with some joints changed so that every branch of the dynamics runs: revolute
+// joints about axes other than z, and prismatic joints (about z and not).
+RobotModel mixed_chain() {
+  RobotModel robot = test::panda();
+  auto set_axis = [&](int i, JointType type, const Eigen::Vector3d& axis) {
+    robot.joints[i].type = type;
+    robot.joints[i].axis = axis.normalized();
+    robot.joints[i].axis_is_z = false;
+  };
+  set_axis(1, JointType::Revolute, Eigen::Vector3d(0.3, -0.5, 0.8));
+  set_axis(2, JointType::Prismatic, Eigen::Vector3d(1, 2, -0.5));
+  set_axis(4, JointType::Revolute, Eigen::Vector3d(0, -1, 0));
+  robot.joints[5].type = JointType::Prismatic;  // along z, with axis_is_z
+  for (int i : {2, 5}) {
+    robot.q_min[i] = robot.joints[i].lower = -0.2;
+    robot.q_max[i] = robot.joints[i].upper = 0.2;
+  }
+  return robot;
+}
+
+// dynamics_terms and forward_dynamics_from_terms against independent reference paths: M from
+// the link Jacobians, gravity and the velocity terms from recursive Newton-Euler, and ddq from
+// Eigen's Cholesky solve of those. For the Panda and for a chain with general axes and
+// prismatic joints, including a first joint that is prismatic.
+TEST(Dynamics, DynamicsTermsMatchReferencePaths) {
+  RobotModel prismatic_first = mixed_chain();
+  prismatic_first.joints[0].type = JointType::Prismatic;
+  prismatic_first.joints[0].axis = Eigen::Vector3d(0.6, 0, 0.8);
+  prismatic_first.joints[0].axis_is_z = false;
+  prismatic_first.q_min[0] = prismatic_first.joints[0].lower = -0.3;
+  prismatic_first.q_max[0] = prismatic_first.joints[0].upper = 0.3;
+  std::mt19937_64 rng(20);
+  for (const RobotModel& robot : {test::panda(), mixed_chain(), prismatic_first}) {
+    RobotData terms(robot), reference(robot);
+    const int n = robot.dof;
+    for (int trial = 0; trial < 200; ++trial) {
+      const State s = random_state(robot, rng);
+      JointVector tau(n);
+      for (int i = 0; i < n; ++i)
+        tau[i] = std::uniform_real_distribution<double>(-1, 1)(rng) * robot.tau_max[i];
+      dynamics_terms(robot, terms, s.q, s.dq);
+      const JointVector& ddq = forward_dynamics_from_terms(terms, tau);
+
+      const JointMatrix M = mass_matrix_from_jacobians(robot, s.q);
+      const JointVector g = gravity_torques(robot, reference, s.q);
+      const JointVector h = rnea(robot, reference, s.q, s.dq, JointVector::Zero(n), false, true);
+      const JointVector expected = Eigen::MatrixXd(M).llt().solve(tau - g - h);
+
+      EXPECT_LT((terms.M - M).norm(), 1e-10 * M.norm()) << "trial " << trial;
+      EXPECT_LT((terms.M - terms.M.transpose()).norm(), 1e-14);
+      EXPECT_LT((terms.gravity - g).norm(), 1e-10 * std::max(1.0, g.norm())) << "trial " << trial;
+      EXPECT_LT((terms.h - h).norm(), 1e-10 * std::max(1.0, h.norm())) << "trial " << trial;
+      EXPECT_LT((ddq - expected).norm(), 1e-10 * std::max(1.0, expected.norm()))
+          << "trial " << trial;
+      // The factor reproduces M.
+      const JointMatrix U = terms.llt_upper.triangularView<Eigen::Upper>();
+      EXPECT_LT((U.transpose() * U - terms.M).norm(), 1e-12 * M.norm());
+      // The one-call forms agree with the shared pass.
+      EXPECT_LT((mass_matrix(robot, reference, s.q) - terms.M).norm(), 1e-12 * M.norm());
+      const JointVector ddq_again = forward_dynamics(robot, reference, s.q, s.dq, tau);
+      EXPECT_LT((ddq_again - ddq).norm(), 1e-12 * std::max(1.0, ddq.norm()));
+      // And inverse dynamics inverts them.
+      const JointVector tau_back = inverse_dynamics(robot, reference, s.q, s.dq, ddq);
+      EXPECT_LT((tau_back - tau).norm(), 1e-9 * std::max(1.0, tau.norm())) << "trial " << trial;
+    }
+  }
+}
+
+// A one-joint chain: the smallest size of the fixed-size Cholesky.
+TEST(Dynamics, SingleJointChain) {
+  RobotModel robot = test::panda();
+  robot.dof = 1;
+  robot.joints.resize(1);
+  robot.bodies.resize(1);
+  RobotData data(robot);
+  JointVector q(1), dq(1), tau(1);
+  q << 0.4;
+  dq << 0.7;
+  tau << 2.0;
+  dynamics_terms(robot, data, q, dq);
+  const JointVector ddq = forward_dynamics_from_terms(data, tau);
+  const JointMatrix M = mass_matrix_from_jacobians(robot, q);
+  const JointVector g = gravity_torques(robot, data, q);
+  const JointVector h = rnea(robot, data, q, dq, JointVector::Zero(1), false, true);
+  EXPECT_NEAR(ddq[0], (tau[0] - g[0] - h[0]) / M(0, 0), 1e-12 * std::abs(ddq[0]));
+}
+
+TEST(Dynamics, SharedTermsDoNotAllocate) {
+  const RobotModel& robot = test::panda();
+  RobotData data(robot);
+  std::mt19937_64 rng(21);
+  const State s = random_state(robot, rng);
+  const JointVector tau = JointVector::Constant(7, 1.0);
+  const long before = test::allocations.load();
+  for (int k = 0; k < 10; ++k) {
+    dynamics_terms(robot, data, s.q, s.dq);
+    forward_dynamics_from_terms(data, tau);
+  }
+  EXPECT_EQ(test::allocations.load() - before, 0);
+}
+
+}  // namespace
+}  // namespace lazyboe

@@ -29,16 +29,19 @@ const JointVector& friction_torques(const RobotModel& model, RobotData& data,
                                     const JointVectorRef& dq);
 double friction_torque(const Friction& friction, double dq);
 
-// Forward dynamics: ddq = M^-1 (tau - C dq - g - tau_f) (data.ddq).
+// Forward dynamics: ddq = M^-1 (tau - C dq - g - tau_f) (data.ddq). Runs dynamics_terms, so
+// it also leaves data.M, its factor, data.gravity and data.h at this state.
 const JointVector& forward_dynamics(const RobotModel& model, RobotData& data,
                                     const JointVectorRef& q, const JointVectorRef& dq,
                                     const JointVectorRef& tau);
 
 // Everything forward dynamics needs at one state, sharing one pass of joint poses: the mass
-// matrix and its Cholesky factor (data.M, data.llt), gravity torques from the composite bodies
-// (data.gravity), and the velocity terms C(q, dq) dq + tau_f(dq) (data.h). A simulator tick
-// then gets ddq for its controller torque from forward_dynamics_from_terms without a second
-// pass.
+// matrix and its Cholesky factor (data.M; data.llt_upper, data.llt_inv_diagonal), gravity torques
+// from the composite bodies (data.gravity), and the velocity terms C(q, dq) dq + tau_f(dq)
+// (data.h). A simulator tick then gets ddq for its controller torque from
+// forward_dynamics_from_terms without a second pass. The velocity terms come from a
+// Newton-Euler pass fused with the composite-inertia pass; rnea() and gravity_torques() stay
+// the separate reference algorithms.
 void dynamics_terms(const RobotModel& model, RobotData& data, const JointVectorRef& q,
                     const JointVectorRef& dq);
 const JointVector& forward_dynamics_from_terms(RobotData& data, const JointVectorRef& tau);

@@ -19,7 +19,8 @@ RobotData::RobotData(const RobotModel& model)
       ddq(JointVector::Zero(model.dof)),
       h(JointVector::Zero(model.dof)),
       M(JointMatrix::Zero(model.dof, model.dof)),
-      llt(model.dof) {}
+      llt_upper(JointMatrix::Zero(model.dof, model.dof)),
+      llt_inv_diagonal(JointVector::Zero(model.dof)) {}
 
 void update_joint_poses(const RobotModel& model, RobotData& data, const JointVectorRef& q) {
   for (int i = 0; i < model.dof; ++i) {

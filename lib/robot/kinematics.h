@@ -1,12 +1,21 @@
 // Forward kinematics and the per-thread workspace of the robot algorithms.
 #pragma once
 
-#include <Eigen/Cholesky>
 #include <vector>
 
 #include "robot/robot_model.h"
 
 namespace lazyboe {
+
+// Inertia of a rigid body (or of a body with everything it carries) about the body's origin, in
+// the body frame: what the composite-rigid-body pass merges and the Newton-Euler pass multiplies
+// with. About the origin, merging needs no centre-of-mass shifts (spatial inertia as in
+// Featherstone, "Rigid Body Dynamics Algorithms", 2008, ch. 2).
+struct OriginInertia {
+  double mass = 0;
+  Eigen::Vector3d first_moment = Eigen::Vector3d::Zero();  // mass times centre of mass
+  Eigen::Matrix3d rotational = Eigen::Matrix3d::Zero();    // about the origin; symmetric
+};
 
 // Scratch space for one thread: sized once from the model, then reused without allocating.
 struct RobotData {
@@ -17,12 +26,16 @@ struct RobotData {
 
   // Recursive Newton-Euler, in body frames.
   std::vector<Eigen::Vector3d> omega, domega, acc, force, moment;
-  // Composite rigid bodies for the mass matrix.
-  std::vector<BodyInertia> composite;
+  // Composite rigid bodies for the mass matrix and the gravity torques: body i and everything
+  // it carries.
+  std::vector<OriginInertia> composite;
 
   JointVector tau, gravity, friction, ddq, h;
   JointMatrix M;
-  Eigen::LLT<JointMatrix> llt;
+  // Cholesky factor of M from dynamics_terms: M = U^T U with U upper triangular (the strictly
+  // lower part is not used), and the inverses of U's diagonal.
+  JointMatrix llt_upper;
+  JointVector llt_inv_diagonal;
 };
 
 // Pose of each joint's body relative to its parent (data.joint_pose); no world poses.
