@@ -1224,5 +1224,55 @@ TEST(Query, StartOrGoalOutsideTheCoverageFailsWithAReason) {
             << (t.results.size() < 2 ? "" : t.results[1].value("failure", "")) << "\n";
 }
 
+
+// An edge whose stored end lies at its own start can be taken lazily again and again from that
+// end, with the heuristic unchanged. Such a chain must end (a tie counts as the heuristic
+// rising), so every lazy edge costs a simulation; before, it grew for free until the budget.
+TEST(Query, ALazyChainWithoutProgressEnds) {
+  const Fixture& f = fixture();
+  const int n = f.data.dof();
+  const size_t k = 0;
+  Bundle one;
+  one.header = f.data.header;
+  auto rows = [&](const std::vector<double>& v, size_t from, size_t to) {
+    return std::vector<double>(v.begin() + from * n, v.begin() + to * n);
+  };
+  one.q0 = rows(f.data.q0, k, k + 1);
+  one.qf = one.q0;  // the stored end is the start
+  one.duration = {f.data.duration[k]};
+  one.command_duration = {f.data.command_duration[k]};
+  one.attempt = {f.data.attempt[k]};
+  one.knot_offset = {0, f.data.knot_offset[k + 1] - f.data.knot_offset[k]};
+  one.knots = rows(f.data.knots, f.data.knot_offset[k], f.data.knot_offset[k + 1]);
+  one.sample_offset = {0, 0};
+  one.header.valid = 1;
+  one.header.target_edges = 1;
+  Perturbation& p = one.perturbation;
+  p = f.data.perturbation;
+  p.done = {p.perturbations};
+  p.valid = {p.perturbations};
+  p.lazy = {p.perturbations};
+  p.collision = {0};
+  p.max_error = {0.0};
+  p.p_lazy_prop = {1.0};  // always taken lazily
+  p.p_collision = {0.0};
+  const std::string path = fresh_dir("self-loop") + "/one.h5";
+  write_bundle(path, one);
+  const BundleView view = BundleView::open(path);
+  const EdgeStartIndex index(view);
+  const PlanningContext context{f.sim, &view, &index};
+
+  const JointVector start = f.edge_start(k);
+  JointVector goal = start;
+  goal[n - 1] += 0.5;  // beyond the tolerance, within theta + tolerance of the stored end
+  PlanningProblem problem = library_problem(f, start, goal, "lazyboe", 0.5);
+  SimulatorWorkspace ws(f.sim);
+  const PlanResult r = plan(context, ws, problem);
+  EXPECT_GT(r.counters.lazy_edges, 0u);
+  EXPECT_LE(r.counters.lazy_edges, r.counters.simulations + 2)
+      << "lazy edges " << r.counters.lazy_edges << ", simulations " << r.counters.simulations
+      << ": a lazy chain went on without simulating";
+}
+
 }  // namespace
 }  // namespace lazyboe::test
