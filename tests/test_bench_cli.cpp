@@ -11,7 +11,9 @@
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
+#include <set>
 #include <sstream>
 #include <thread>
 
@@ -153,10 +155,30 @@ TEST(BenchCli, TinyStudyWritesEveryFileWithConsistentRows) {
   const std::string again = fresh_dir("study-again");
   const CommandResult r2 =
       bench("--problems-file " + quote(dir + "/problems.jsonl") +
-            " --planners rrt --budget 0.5 --no-figures --quiet --out " + quote(again));
+            " --planners rrt,sst-1x --repeats 2 --budget 0.3 --no-figures --quiet --seed 3 "
+            "--out " +
+            quote(again));
   ASSERT_EQ(r2.exit_code, 0) << describe(r2);
   EXPECT_EQ(read_file(again + "/problems.jsonl"), read_file(dir + "/problems.jsonl"));
-  EXPECT_EQ(lines_of(read_file(again + "/runs.csv")).size(), 3u);
+  // 2 planners x 2 problems x 2 repeats; a (problem, repeat) has one seed for every planner,
+  // repeats have their own, and the seeds are the first study's for the same study seed.
+  const std::vector<std::string> repeated = lines_of(read_file(again + "/runs.csv"));
+  ASSERT_EQ(repeated.size(), 9u);
+  std::map<std::pair<std::string, std::string>, std::set<std::string>> seeds;
+  std::set<std::string> all_seeds;
+  for (size_t k = 1; k < repeated.size(); ++k) {
+    const std::vector<std::string> f = fields_of(repeated[k]);
+    seeds[std::make_pair(f[1], f[2])].insert(f[3]);
+    all_seeds.insert(f[3]);
+  }
+  EXPECT_EQ(seeds.size(), 4u);
+  for (const auto& [key, s] : seeds) EXPECT_EQ(s.size(), 1u) << key.first << " " << key.second;
+  EXPECT_EQ(all_seeds.size(), 4u);
+  for (size_t k = 1; k < rows.size(); ++k) {
+    const std::vector<std::string> f = fields_of(rows[k]);
+    const std::set<std::string>& same = seeds[std::make_pair(f[1], f[2])];
+    EXPECT_EQ(same.count(f[3]), 1u) << rows[k];
+  }
 
   // An earlier study is not overwritten without --force.
   const auto before = snapshot(dir);
