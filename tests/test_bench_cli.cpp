@@ -9,15 +9,19 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
 #include <thread>
 
+#include "bench/report.h"
 #include "cli_util.h"
+#include "common/error.h"
 #include "planning/ompl_planners.h"
 
 namespace lazyboe::test {
@@ -266,6 +270,86 @@ TEST(BenchCli, BadInputIsOneLineError) {
   expect_one_line_error(run(quote(tool_path("lazyboe-bench")) + " --bundle " +
                             quote(dir + "/missing.h5") + " --out " + quote(dir + "/out")),
                         {"missing.h5"});
+}
+
+// The partial file's reader skips a row an interruption cut short, and the writer drops it
+// before appending, so a study interrupted twice still resumes. Fields are parsed strictly.
+TEST(BenchRuns, PartialFileSurvivesATornRowAndRejectsBadFields) {
+  const std::string dir = fresh_dir("partial");
+  const std::string path = dir + "/runs.partial.csv";
+  RunRecord a;
+  a.planner = "rrt";
+  a.problem = 0;
+  a.seed = 42;
+  a.success = true;
+  a.time_to_first_solution = 0.5;
+  a.best_cost = 1.25;
+  a.n_solutions = 1;
+  a.counters.simulations = 7;
+  a.budget = 1;
+  RunRecord b = a;
+  b.problem = 1;
+  b.success = false;
+  b.time_to_first_solution = b.best_cost = std::numeric_limits<double>::quiet_NaN();
+  b.n_solutions = 0;
+  b.failure = "no solution, \"quoted\"";
+  const std::vector<std::string> ids = {"p0", "p1"};
+  {
+    PartialRunsFile f(path);
+    f.append(a, "p0");
+  }
+  const std::string whole = read_file(path);
+  write_bytes(path, whole + runs_csv_row(b, "p1").substr(0, 20));  // torn
+  ASSERT_EQ(read_runs_csv(path, ids).size(), 1u);
+  {
+    PartialRunsFile f(path);  // drops the torn row
+    f.append(b, "p1");
+  }
+  const std::vector<RunRecord> runs = read_runs_csv(path, ids);
+  ASSERT_EQ(runs.size(), 2u);
+  EXPECT_EQ(runs[0].seed, 42u);
+  EXPECT_DOUBLE_EQ(runs[0].best_cost, 1.25);
+  EXPECT_FALSE(runs[1].success);
+  EXPECT_EQ(runs[1].failure, b.failure);
+  EXPECT_TRUE(std::isnan(runs[1].time_to_first_solution));
+
+  const std::string header = lines_of(whole)[0];
+  for (const auto& [row, field] : std::vector<std::pair<std::string, std::string>>{
+           {"rrt,p0,0,-5,1,0.5,1.25,1,0,7,0,0,1,", "seed"},
+           {"rrt,p0,0,42,yes,0.5,1.25,1,0,7,0,0,1,", "success"},
+           {"rrt,p0,0,42,1,0.5,1.25,1.7,0,7,0,0,1,", "n_solutions"},
+           {"rrt,p0,0,42,1,0.5,1.25,1,0,,0,0,1,", "simulations"},
+           {"rrt,p9,0,42,1,0.5,1.25,1,0,7,0,0,1,", "problem"}}) {
+    write_bytes(path, header + "\n" + row + "\n");
+    try {
+      read_runs_csv(path, ids);
+      ADD_FAILURE() << "accepted: " << row;
+    } catch (const Error& e) {
+      EXPECT_TRUE(contains(e.what(), "line 2") && contains(e.what(), field)) << e.what();
+    }
+  }
+}
+
+TEST(BenchCli, ResumeOfAFinishedStudyRunsNothingAgain) {
+  const std::string dir = fresh_dir("finished");
+  const std::string args =
+      "--problems 2 --planners rrt --budget 0.3 --no-figures --out " + quote(dir);
+  ASSERT_EQ(bench(args + " --quiet").exit_code, 0);
+  const std::string runs = read_file(dir + "/runs.csv");
+  const CommandResult again = bench(args + " --resume");
+  ASSERT_EQ(again.exit_code, 0) << describe(again);
+  EXPECT_TRUE(contains(again.err, "0 runs to do (2 done)")) << again.err;
+  EXPECT_EQ(read_file(dir + "/runs.csv"), runs);
+  expect_one_line_error(
+      bench("--problems 3 --planners rrt --budget 0.3 --out " + quote(dir) + " --resume"),
+      {"study.json", "other parameters"});
+
+  // Problem ids must be unique in a problems file.
+  const std::vector<std::string> lines = lines_of(read_file(dir + "/problems.jsonl"));
+  write_bytes(dir + "/twice.jsonl", lines[0] + "\n" + lines[0] + "\n");
+  expect_one_line_error(bench("--problems-file " + quote(dir + "/twice.jsonl") +
+                              " --planners rrt --quiet --out " + quote(dir + "/twice")),
+                        {"twice.jsonl", "line 2", "repeated"});
 }
 
 }  // namespace

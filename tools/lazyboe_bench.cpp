@@ -26,7 +26,8 @@ std::string machine_description() {
   std::ifstream cpu("/proc/cpuinfo");
   for (std::string line; std::getline(cpu, line);) {
     if (line.rfind("model name", 0) == 0) {
-      model = line.substr(line.find(':') + 2);
+      const size_t colon = line.find(':');
+      if (colon != std::string::npos && colon + 2 <= line.size()) model = line.substr(colon + 2);
       break;
     }
   }
@@ -40,12 +41,16 @@ std::string machine_description() {
 
 // The parameters a resumed study must share with the interrupted one.
 nlohmann::json study_parameters(const std::string& bundle, const std::string& planners,
-                                double budget, int repeats, uint64_t seed) {
+                                double budget, int repeats, uint64_t seed, int problems,
+                                const std::string& problems_file, double tolerance) {
   return {{"bundle", fs::absolute(bundle).string()},
           {"planners", planners},
           {"budget", budget},
           {"repeats", repeats},
-          {"seed", seed}};
+          {"seed", seed},
+          {"problems", problems},
+          {"problems_file", problems_file.empty() ? "" : fs::absolute(problems_file).string()},
+          {"tolerance", tolerance}};
 }
 
 void write_text(const fs::path& path, const std::string& text) {
@@ -139,15 +144,16 @@ int main(int argc, char** argv) {
            "holds an earlier study; use --resume to continue it or --force to "
            "replace it");
     }
-    if (jobs > static_cast<int>(std::thread::hardware_concurrency())) {
+    const unsigned cores = std::thread::hardware_concurrency();  // 0 when unknown
+    if (cores > 0 && jobs > static_cast<int>(cores)) {
       std::fprintf(stderr,
                    "lazyboe-bench: warning: %d jobs on %u cores: budgets are wall time, so runs "
                    "sharing a core get less planning time\n",
                    jobs, std::thread::hardware_concurrency());
     }
 
-    const nlohmann::json parameters =
-        study_parameters(bundle_path, planners, budget, repeats, seed);
+    const nlohmann::json parameters = study_parameters(bundle_path, planners, budget, repeats, seed,
+                                                       problems, problems_file, tolerance);
     if (resume) {  // before anything is loaded: a mismatch is refused at once
       std::ifstream in(study_path);
       nlohmann::json saved;
@@ -188,8 +194,9 @@ int main(int argc, char** argv) {
       study_problems = read_problems(problems_path.string(), session.sim, ws, query_defaults);
       problems_source = "resumed from " + problems_path.string();
     } else {
-      if (force) {
-        for (const fs::path& p : {runs_path, partial_path, dir / "summary.md"}) fs::remove(p);
+      if (force) {  // study.json first: its absence marks the directory as not resumable
+        for (const fs::path& p : {study_path, runs_path, partial_path, dir / "summary.md"})
+          fs::remove(p);
       }
       if (!problems_file.empty()) {
         study_problems = read_problems(problems_file, session.sim, ws, query_defaults);
@@ -208,13 +215,18 @@ int main(int argc, char** argv) {
     std::vector<std::string> problem_ids;
     for (const BenchProblem& p : study_problems) problem_ids.push_back(p.id);
 
-    // Runs already done (resume), then the rest: problem by problem, every planner in turn, so
-    // a partial study is balanced across planners.
     std::vector<RunRecord> runs;
-    if (resume && fs::exists(partial_path))
+    // Runs already done: the partial file of an interrupted study, or the runs.csv of a
+    // finished one (resuming it only writes its summary and figures again).
+    if (resume && fs::exists(partial_path)) {
       runs = read_runs_csv(partial_path.string(), problem_ids);
+    } else if (resume && fs::exists(runs_path)) {
+      runs = read_runs_csv(runs_path.string(), problem_ids);
+    }
     std::map<std::tuple<std::string, int, int>, bool> have;
     for (const RunRecord& r : runs) have[{r.planner, r.problem, r.repeat}] = true;
+    // The rest: problem by problem, every planner in turn, so that a partial study is balanced
+    // across planners.
     std::vector<StudyTask> tasks;
     for (int rep = 0; rep < repeats; ++rep) {
       for (int p = 0; p < static_cast<int>(study_problems.size()); ++p) {
@@ -255,7 +267,7 @@ int main(int argc, char** argv) {
     const std::vector<RunRecord> fresh =
         run_study(session.context(), specs, study_problems, tasks, budget, seed, control);
     runs.insert(runs.end(), fresh.begin(), fresh.end());
-    if (stop_requested()) {
+    if (fresh.size() < tasks.size()) {  // stopped before every run was done
       std::fprintf(stderr,
                    "lazyboe-bench: interrupted: %zu runs saved in %s; continue with --resume\n",
                    runs.size(), partial_path.c_str());

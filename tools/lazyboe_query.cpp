@@ -124,7 +124,7 @@ int main(int argc, char** argv) {
         o.success = r.success;
         o.ttfs = r.time_to_first_solution;
         o.cost = have ? traj.cost : 0;
-      } catch (const Error& e) {
+      } catch (const std::exception& e) {  // Error, or anything else: never out of a job
         j = error_json(id, line, o.planner, e.what());
         o.error = true;
       }
@@ -178,7 +178,7 @@ int main(int argc, char** argv) {
         else
           by_planner[o.planner].push_back(&o);
       }
-      std::fprintf(stderr, "%-8s %7s %8s %14s %14s %10s\n", "planner", "queries", "success",
+      std::fprintf(stderr, "%-11s %7s %8s %14s %14s %10s\n", "planner", "queries", "success",
                    "median TTFS s", "mean TTFS s", "mean cost");
       for (const auto& [name, list] : by_planner) {
         std::vector<double> ttfs, cost;
@@ -188,7 +188,7 @@ int main(int argc, char** argv) {
           cost.push_back(o->cost);
         }
         const Quantiles qt = quantiles(ttfs), qc = quantiles(cost);
-        std::fprintf(stderr, "%-8s %7zu %7.0f%% %14.4f %14.4f %10.3f\n", name.c_str(), list.size(),
+        std::fprintf(stderr, "%-11s %7zu %7.0f%% %14.4f %14.4f %10.3f\n", name.c_str(), list.size(),
                      100.0 * ttfs.size() / list.size(), qt.median, qt.mean, qc.mean);
       }
       if (errors)

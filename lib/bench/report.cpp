@@ -1,8 +1,11 @@
 #include "bench/report.h"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <map>
 #include <sstream>
 
@@ -70,6 +73,15 @@ double parse_number(const std::string& text, const std::string& where, const std
   return value;
 }
 
+uint64_t parse_count(const std::string& text, const std::string& where, const std::string& column) {
+  uint64_t value = 0;
+  const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
+  if (text.empty() || error != std::errc() || end != text.data() + text.size()) {
+    fail(where, column + ": expected a whole number >= 0, got '" + text + "'");
+  }
+  return value;
+}
+
 }  // namespace
 
 const std::vector<std::string>& runs_csv_header() {
@@ -91,9 +103,17 @@ std::string runs_csv_row(const RunRecord& r, const std::string& problem_id) {
 }
 
 PartialRunsFile::PartialRunsFile(const std::string& path) : path_(path) {
-  std::ifstream existing(path);
-  const bool fresh = !existing || existing.peek() == std::ifstream::traits_type::eof();
-  existing.close();
+  std::string bytes;
+  {
+    std::ifstream existing(path, std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(existing), std::istreambuf_iterator<char>());
+  }
+  const bool fresh = bytes.empty();
+  if (!fresh && bytes.back() != '\n') {
+    // A row an interruption cut short (read_runs_csv ignored it): drop it, so the next row
+    // starts on a line of its own.
+    std::filesystem::resize_file(path, bytes.rfind('\n') + 1);
+  }
   file_ = std::fopen(path.c_str(), "a");
   if (!file_) fail(path, "cannot write");
   if (fresh) {
@@ -146,17 +166,17 @@ std::vector<RunRecord> read_runs_csv(const std::string& path,
     const auto problem = index_of.find(fields[1]);
     if (problem == index_of.end()) fail(where, "problem: '" + fields[1] + "' is not in the study");
     r.problem = problem->second;
-    r.repeat = static_cast<int>(parse_number(fields[2], where, "repeat"));
-    r.seed = static_cast<uint64_t>(std::stoull(fields[3].empty() ? "0" : fields[3]));
-    r.success = parse_number(fields[4], where, "success") == 1;
+    r.repeat = static_cast<int>(parse_count(fields[2], where, "repeat"));
+    r.seed = parse_count(fields[3], where, "seed");
+    if (fields[4] != "0" && fields[4] != "1") fail(where, "success: expected 0 or 1");
+    r.success = fields[4] == "1";
     r.time_to_first_solution = parse_number(fields[5], where, "time_to_first_solution");
     r.best_cost = parse_number(fields[6], where, "best_cost");
-    r.n_solutions = static_cast<int>(parse_number(fields[7], where, "n_solutions"));
-    r.counters.nodes = static_cast<uint64_t>(parse_number(fields[8], where, "nodes"));
-    r.counters.simulations = static_cast<uint64_t>(parse_number(fields[9], where, "simulations"));
-    r.counters.lazy_edges = static_cast<uint64_t>(parse_number(fields[10], where, "lazy_edges"));
-    r.counters.collision_checks =
-        static_cast<uint64_t>(parse_number(fields[11], where, "collision_checks"));
+    r.n_solutions = static_cast<int>(parse_count(fields[7], where, "n_solutions"));
+    r.counters.nodes = parse_count(fields[8], where, "nodes");
+    r.counters.simulations = parse_count(fields[9], where, "simulations");
+    r.counters.lazy_edges = parse_count(fields[10], where, "lazy_edges");
+    r.counters.collision_checks = parse_count(fields[11], where, "collision_checks");
     r.budget = parse_number(fields[12], where, "budget");
     r.failure = fields[13];
     runs.push_back(std::move(r));
@@ -277,9 +297,13 @@ std::string summary_markdown(const StudyInfo& info, const std::vector<PlannerSpe
     if (stats.count("ompl-sst") && stats["ompl-sst"].runs > 0) {
       const double sst_median = median_of(stats["ompl-sst"].ttfs);
       const double ratio = sst_median / lazy_median;
-      md << "- LazyBoE's median time to first solution at least 10x lower than OMPL's SST: "
-         << fixed(lazy_median, 3) << " s against " << fixed(sst_median, 3) << " s, "
-         << fixed(ratio, 1) << "x: " << verdict(std::isfinite(ratio) && ratio >= 10) << "\n";
+      md << "- LazyBoE's median time to first solution at least 10x lower than OMPL's SST: ";
+      if (std::isfinite(ratio)) {
+        md << fixed(lazy_median, 3) << " s against " << fixed(sst_median, 3) << " s, "
+           << fixed(ratio, 1) << "x: " << verdict(ratio >= 10) << "\n";
+      } else {
+        md << "not measurable (no successful run of one of them)\n";
+      }
     } else {
       md << "- LazyBoE against OMPL's SST: not measured (ompl-sst not in this study)\n";
     }
@@ -297,9 +321,13 @@ std::string summary_markdown(const StudyInfo& info, const std::vector<PlannerSpe
        << verdict(best && rate(lazy) >= 0.92) << "\n";
     if (stats.count("boe") && stats["boe"].runs > 0) {
       const double boe_cost = median_of(stats["boe"].cost), lazy_cost = median_of(lazy.cost);
-      md << "- Final cost no worse than BoE's (median): " << fixed(lazy_cost, 2) << " rad against "
-         << fixed(boe_cost, 2)
-         << " rad: " << verdict(std::isfinite(lazy_cost) && lazy_cost <= boe_cost) << "\n";
+      md << "- Final cost no worse than BoE's (median): ";
+      if (std::isfinite(lazy_cost) && std::isfinite(boe_cost)) {
+        md << fixed(lazy_cost, 2) << " rad against " << fixed(boe_cost, 2)
+           << " rad: " << verdict(lazy_cost <= boe_cost) << "\n";
+      } else {
+        md << "not measurable (no successful run of one of them)\n";
+      }
     } else {
       md << "- Final cost against BoE: not measured (boe not in this study)\n";
     }

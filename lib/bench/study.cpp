@@ -81,11 +81,18 @@ RunRecord run_planner(const PlanningContext& context, SimulatorWorkspace& ws,
       r.failure = result.failure;
       return r;
     }
-    const Trajectory t = realize_path(context.sim, ws, p.start, result.best_path, p.goal, 1000);
+    const Trajectory t = [&] {
+      try {
+        return realize_path(context.sim, ws, p.start, result.best_path, p.goal, 1000);
+      } catch (const Error&) {
+        r.n_solutions = 0;  // the path failed the re-check: it is not a solution
+        throw;
+      }
+    }();
     r.success = true;
     r.time_to_first_solution = result.time_to_first_solution;
     r.best_cost = t.cost;
-  } catch (const Error& e) {
+  } catch (const std::exception& e) {  // nothing may leave a run (an OpenMP region)
     r.success = false;
     r.failure = std::string("error: ") + e.what();
   }
