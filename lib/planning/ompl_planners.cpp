@@ -361,6 +361,9 @@ PlanResult plan_ompl(const PlanningContext& ctx, SimulatorWorkspace& ws,
   seed_ompl(params.seed);
 
   Search search(ctx, ws, problem);  // outlives every OMPL object below
+  // The clock starts here, as our planners' does at their start: OMPL's setup is part of the
+  // time to first solution and of the budget.
+  search.solve_start = Clock::now();
   PlanResult result;
   try {
     // States: the sampling box, widened to hold the start and a joint goal.
@@ -450,8 +453,8 @@ PlanResult plan_ompl(const PlanningContext& ctx, SimulatorWorkspace& ws,
     planner->setProblemDefinition(pdef);
     planner->setup();
 
-    const ob::PlannerTerminationCondition ptc = ob::timedPlannerTerminationCondition(params.budget);
-    search.solve_start = Clock::now();
+    const ob::PlannerTerminationCondition ptc =
+        ob::timedPlannerTerminationCondition(std::max(0.0, params.budget - search.elapsed()));
     const ob::PlannerStatus status = planner->solve(ptc);
 
     result.counters = search.counters;
