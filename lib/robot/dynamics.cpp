@@ -1,10 +1,89 @@
 #include "robot/dynamics.h"
 
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <type_traits>
 
 namespace lazyboe {
 namespace {
+
+// sin and cos of a joint angle, for the joint poses of the per-tick path (dynamics_terms):
+// libm's sincos is about 120 instructions, this about half. x = k pi/2 + r with |r| <= pi/4
+// (pi/2 in three parts, the first two short enough that k times them is exact), then the Taylor
+// series of sin r to r^17 and cos r to r^18 (truncation below 1e-19) and the quadrant of k.
+// Within about 1 ulp of std::sin and std::cos (tests/test_dynamics.cpp); beyond |x| = 1e5 (and
+// for NaN) it calls them.
+inline void joint_sincos(double x, double& sin_x, double& cos_x) {
+  if (!(std::abs(x) < 1e5)) {
+    sin_x = std::sin(x);
+    cos_x = std::cos(x);
+    return;
+  }
+  constexpr double kShift = 0x1.8p52;  // adding it rounds to an integer in the low bits
+  const double shifted = x * 0x1.45f306dc9c883p-1 + kShift;  // x 2/pi
+  std::uint64_t bits;
+  std::memcpy(&bits, &shifted, sizeof bits);
+  const auto k = static_cast<std::uint32_t>(bits);  // k mod 2^32, enough for the quadrant
+  const double kd = shifted - kShift;
+  const double r =
+      ((x - kd * 0x1.921fb54400000p+0) - kd * 0x1.0b4611a600000p-34) - kd * 0x1.3198a2e037073p-69;
+  // Taylor coefficients of sin r = r + r^3 (a0 + a1 r^2 + ...), cos r = 1 - r^2/2 + r^4 (b0 + ...).
+  constexpr double kSin[] = {
+      -1.0 / 6,        1.0 / 120,        -1.0 / 5040,          1.0 / 362880,
+      -1.0 / 39916800, 1.0 / 6227020800, -1.0 / 1307674368000, 1.0 / 355687428096000};
+  constexpr double kCos[] = {
+      1.0 / 24,        -1.0 / 720,         1.0 / 40320,          -1.0 / 3628800,
+      1.0 / 479001600, -1.0 / 87178291200, 1.0 / 20922789888000, -1.0 / 6402373705728000};
+  const double z = r * r;
+  double ps = kSin[7], pc = kCos[7];
+  for (int i = 6; i >= 0; --i) {  // Horner in z
+    ps = kSin[i] + z * ps;
+    pc = kCos[i] + z * pc;
+  }
+  const double s = r + r * z * ps;
+  const double c = 1.0 - 0.5 * z + z * z * pc;
+  switch (k & 3) {
+    case 0:
+      sin_x = s;
+      cos_x = c;
+      break;
+    case 1:
+      sin_x = c;
+      cos_x = -s;
+      break;
+    case 2:
+      sin_x = -s;
+      cos_x = -c;
+      break;
+    default:
+      sin_x = -c;
+      cos_x = s;
+      break;
+  }
+}
+
+// update_joint_poses (kinematics.cpp) with joint_sincos for revolute joints about z.
+void joint_poses_for_dynamics(const RobotModel& model, RobotData& data, const JointVectorRef& q) {
+  for (int i = 0; i < model.dof; ++i) {
+    const Joint& j = model.joints[i];
+    Pose& X = data.joint_pose[i];
+    if (j.type == JointType::Revolute && j.axis_is_z) {
+      double s, c;
+      joint_sincos(q[i], s, c);
+      X.R.col(0) = c * j.origin.R.col(0) + s * j.origin.R.col(1);
+      X.R.col(1) = c * j.origin.R.col(1) - s * j.origin.R.col(0);
+      X.R.col(2) = j.origin.R.col(2);
+      X.p = j.origin.p;
+    } else if (j.type == JointType::Revolute) {
+      X.R.noalias() = j.origin.R * Eigen::AngleAxisd(q[i], j.axis).toRotationMatrix();
+      X.p = j.origin.p;
+    } else {
+      X.R = j.origin.R;
+      X.p = j.origin.p + j.origin.R * (j.axis * q[i]);
+    }
+  }
+}
 
 // RNEA over the joint poses already in data.joint_pose; writes data.tau.
 void rnea_from_poses(const RobotModel& model, RobotData& data, const JointVectorRef& dq,
@@ -368,6 +447,312 @@ void cholesky_solve(const RobotData& data, int n, double* x) {
   });
 }
 
+// ---- Articulated-body algorithm ------------------------------------------------------------
+//
+// Featherstone, "Rigid Body Dynamics Algorithms" (2008), ch. 7, table 7.1, over body frames with
+// spatial quantities split into 3-vectors about each body's origin: a motion vector is
+// (w, v) (angular; linear velocity of the origin), a force (n, f) (moment about the origin;
+// force). A spatial inertia, rigid or articulated, is the symmetric 6x6 [[A, B], [B^T, C]]:
+//   n = A dw + B a,  f = B^T dw + C a.
+// A rigid body about its origin has A = I_O, B = h x (h = m c, the first moment), C = m 1.
+// Joint i's motion subspace S is (axis, 0) for a revolute joint and (0, axis) for a prismatic
+// one, in body i's frame.
+
+struct ArticulatedBody {
+  double A[3][3], B[3][3], C[3][3];  // articulated inertia I^A (A, C symmetric: upper triangles)
+  Eigen::Vector3d pn, pf;            // bias force p^A
+  Eigen::Vector3d cw, cv;            // velocity-product acceleration c = v x (S dq)
+  Eigen::Vector3d Uw, Uv;            // U = I^A S
+  double inv_D, u;                   // 1 / (S^T U), tau - tau_f - S^T p^A
+};
+
+// The upper triangle of a symmetric 3x3 (the strictly lower part is not kept up to date).
+inline double upper(const double (&M)[3][3], int r, int c) { return r <= c ? M[r][c] : M[c][r]; }
+
+// R M R^T for a 3x3 M (rows and columns in `used` only; the others are zero). With
+// `symmetric`, M is symmetric and only the upper triangle of the result is computed (and
+// mirrored).
+template <int kUsedRows, int kUsedCols, bool kSymmetric>
+inline void rotate_matrix(const Eigen::Matrix3d& R, const double (&M)[3][3], double (&out)[3][3]) {
+  // A symmetric M is read from its upper triangle only, and only that of the result is written.
+  auto at = [&](int r, int c) { return kSymmetric ? upper(M, r, c) : M[r][c]; };
+  double T[3][kUsedCols];  // R M, columns 0..kUsedCols-1
+  for (int r = 0; r < 3; ++r) {
+    for (int k = 0; k < kUsedCols; ++k) {
+      double s = R(r, 0) * at(0, k);
+      for (int m = 1; m < kUsedRows; ++m) s += R(r, m) * at(m, k);
+      T[r][k] = s;
+    }
+  }
+  for (int r = 0; r < 3; ++r) {
+    for (int c = kSymmetric ? r : 0; c < 3; ++c) {
+      double s = T[r][0] * R(c, 0);
+      for (int k = 1; k < kUsedCols; ++k) s += T[r][k] * R(c, k);
+      out[r][c] = s;
+    }
+  }
+}
+
+// p x v
+inline void cross_into(const Eigen::Vector3d& p, double v0, double v1, double v2,
+                       double (&out)[3]) {
+  out[0] = p.y() * v2 - p.z() * v1;
+  out[1] = p.z() * v0 - p.x() * v2;
+  out[2] = p.x() * v1 - p.y() * v0;
+}
+
+// parent.I^A += X^T I^a X, the articulated inertia I^a = [[A, B], [B^T, C]] of body i (after
+// the joint's projection) moved into the parent's frame, X = data.joint_pose[i]. First the
+// rotation, A' = R A R^T etc.; then the shift by p with P = p x:
+//   A'' = A' + P B'^T - (B' + P C') P,  B'' = B' + P C',  C'' = C'.
+// kRevoluteZ: after the projection of a revolute joint about z, I^a S = 0, so row and column 2
+// of A and row 2 of B vanish and are skipped.
+template <bool kRevoluteZ>
+inline void add_articulated_inertia(const ArticulatedBody& body, const Pose& X,
+                                    ArticulatedBody& parent) {
+  constexpr int kUsed = kRevoluteZ ? 2 : 3;
+  const Eigen::Matrix3d& R = X.R;
+  const Eigen::Vector3d& p = X.p;
+  double A[3][3], B[3][3], C[3][3];
+  rotate_matrix<kUsed, kUsed, true>(R, body.A, A);
+  rotate_matrix<kUsed, 3, false>(R, body.B, B);
+  rotate_matrix<3, 3, true>(R, body.C, C);
+  // B'' = B' + P C', column by column.
+  double Bs[3][3];
+  for (int c = 0; c < 3; ++c) {
+    double pc[3];
+    cross_into(p, upper(C, 0, c), upper(C, 1, c), upper(C, 2, c), pc);
+    for (int r = 0; r < 3; ++r) Bs[r][c] = B[r][c] + pc[r];
+  }
+  // (P B'^T)_rc = (p x row c of B')_r and -(B'' P)_rc = (p x row r of B'')_c.
+  double pb[3][3], pbs[3][3];
+  for (int r = 0; r < 3; ++r) {
+    cross_into(p, B[r][0], B[r][1], B[r][2], pb[r]);
+    cross_into(p, Bs[r][0], Bs[r][1], Bs[r][2], pbs[r]);
+  }
+  for (int r = 0; r < 3; ++r) {
+    for (int c = r; c < 3; ++c) parent.A[r][c] += A[r][c] + pb[c][r] + pbs[r][c];
+  }
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) parent.B[r][c] += Bs[r][c];
+  }
+  for (int r = 0; r < 3; ++r) {
+    for (int c = r; c < 3; ++c) parent.C[r][c] += C[r][c];
+  }
+}
+
+// Body i's articulated inertia and bias force, projected through its joint and moved into the
+// parent's frame, added to the parent's:
+//   I^a = I^A - U U^T / D,  p^a = p^A + I^a c + U u / D,  parent += X^T I^a X, X^T p^a.
+// kRevoluteZ: a revolute joint about z, for which I^a S = 0 zeroes row and column 2 of A and
+// row 2 of B, and c has no z components; those terms are skipped.
+template <bool kRevoluteZ>
+inline void project_to_parent(ArticulatedBody& b, const Pose& X, ArticulatedBody& parent) {
+  constexpr int kUsed = kRevoluteZ ? 2 : 3;
+  const Eigen::Vector3d sw = b.Uw * b.inv_D, sv = b.Uv * b.inv_D;
+  for (int r = 0; r < kUsed; ++r) {
+    for (int c = r; c < kUsed; ++c) b.A[r][c] -= b.Uw[r] * sw[c];
+    for (int c = 0; c < 3; ++c) b.B[r][c] -= b.Uw[r] * sv[c];
+  }
+  for (int r = 0; r < 3; ++r) {
+    for (int c = r; c < 3; ++c) b.C[r][c] -= b.Uv[r] * sv[c];
+  }
+  const double ud = b.u * b.inv_D;
+  Eigen::Vector3d pn, pf;
+  for (int r = 0; r < 3; ++r) {
+    double n = b.pn[r] + b.Uw[r] * ud;
+    double f = b.pf[r] + b.Uv[r] * ud;
+    for (int k = 0; k < kUsed; ++k) {
+      if (!kRevoluteZ || r < 2) n += upper(b.A, r, k) * b.cw[k] + b.B[r][k] * b.cv[k];
+      f += b.B[k][r] * b.cw[k] + upper(b.C, r, k) * b.cv[k];
+    }
+    pn[r] = n;
+    pf[r] = f;
+  }
+  const Eigen::Vector3d f = rotate(X.R, pf);
+  parent.pf += f;
+  parent.pn += rotate(X.R, pn) + X.p.cross(f);
+  add_articulated_inertia<kRevoluteZ>(b, X, parent);
+}
+
+// Gravity torques from the joint poses: joint i holds the weight of its subtree (composite mass
+// mc and first moment hc about body i's origin, gathered from the tip), g_i = -(a x hc) . g
+// about a revolute axis a and -mc a . g along a prismatic one, with gravity g in body i's frame.
+void gravity_from_poses(const RobotModel& model, RobotData& data) {
+  const int n = model.dof;
+  Eigen::Vector3d g_body[kMaxDof];
+  Eigen::Vector3d g = model.gravity;
+  for (int i = 0; i < n; ++i) {
+    g = data.joint_pose[i].R.transpose() * g;
+    g_body[i] = g;
+  }
+  double mc = 0;
+  Eigen::Vector3d hc = Eigen::Vector3d::Zero();
+  for (int i = n - 1; i >= 0; --i) {
+    if (i + 1 < n) {
+      const Pose& X = data.joint_pose[i + 1];
+      hc = rotate(X.R, hc) + mc * X.p;
+    }
+    const BodyInertia& body = model.bodies[i];
+    hc += body.mass * body.com;
+    mc += body.mass;
+    const Joint& j = model.joints[i];
+    const Eigen::Vector3d& gi = g_body[i];
+    if (j.type == JointType::Revolute) {
+      data.gravity[i] =
+          j.axis_is_z ? hc.y() * gi.x() - hc.x() * gi.y() : -axis_cross(j, hc).dot(gi);
+    } else {
+      data.gravity[i] = -mc * along_axis(j, gi);
+    }
+  }
+}
+
+// The three passes of the articulated-body algorithm over data.joint_pose; writes data.ddq.
+// Gravity enters as an upward acceleration of the base and friction is taken from tau.
+void articulated_body_from_poses(const RobotModel& model, RobotData& data, const JointVectorRef& dq,
+                                 const JointVectorRef& tau) {
+  const int n = model.dof;
+  ArticulatedBody art[kMaxDof];
+
+  // Pass 1, outwards: velocities, the velocity-product accelerations c and the bias forces
+  // p = v x* (I v) of the rigid bodies, whose inertias start I^A.
+  Eigen::Vector3d w_prev = Eigen::Vector3d::Zero(), v_prev = Eigen::Vector3d::Zero();
+  for (int i = 0; i < n; ++i) {
+    const Joint& j = model.joints[i];
+    const Pose& X = data.joint_pose[i];
+    const double qd = dq[i];
+    ArticulatedBody& b = art[i];
+    Eigen::Vector3d w_in, v_in;
+    if (i == 0) {  // the base is at rest
+      w_in.setZero();
+      v_in.setZero();
+    } else {
+      w_in = X.R.transpose() * w_prev;
+      v_in = X.R.transpose() * (v_prev + w_prev.cross(X.p));
+    }
+    Eigen::Vector3d w = w_in, v = v_in;
+    if (j.type == JointType::Revolute) {
+      if (j.axis_is_z) {
+        w.z() += qd;
+        b.cw = Eigen::Vector3d(w_in.y() * qd, -w_in.x() * qd, 0.0);
+        b.cv = Eigen::Vector3d(v_in.y() * qd, -v_in.x() * qd, 0.0);
+      } else {
+        const Eigen::Vector3d s = j.axis * qd;
+        w += s;
+        b.cw = w_in.cross(s);
+        b.cv = v_in.cross(s);
+      }
+    } else {
+      const Eigen::Vector3d s = j.axis * qd;
+      v += s;
+      b.cw.setZero();
+      b.cv = w_in.cross(s);
+    }
+    OriginInertia body;
+    origin_inertia(model.bodies[i], body);
+    const Eigen::Vector3d& h = body.first_moment;
+    const Eigen::Matrix3d& I = body.rotational;
+    for (int r = 0; r < 3; ++r) {  // A and C: upper triangles
+      for (int c = r; c < 3; ++c) {
+        b.A[r][c] = I(r, c);
+        b.C[r][c] = r == c ? body.mass : 0.0;
+      }
+    }
+    b.B[0][0] = 0;
+    b.B[0][1] = -h.z();
+    b.B[0][2] = h.y();
+    b.B[1][0] = h.z();
+    b.B[1][1] = 0;
+    b.B[1][2] = -h.x();
+    b.B[2][0] = -h.y();
+    b.B[2][1] = h.x();
+    b.B[2][2] = 0;
+    const Eigen::Vector3d L = rotate(I, w) + h.cross(v);   // angular momentum about the origin
+    const Eigen::Vector3d P = body.mass * v + w.cross(h);  // linear momentum
+    b.pn = w.cross(L) + v.cross(P);
+    b.pf = w.cross(P);
+    w_prev = w;
+    v_prev = v;
+  }
+
+  // Pass 2, inwards: U, D and u of each joint, and the articulated inertia and bias force of
+  // each body, projected through its joint, added to its parent's.
+  for (int i = n - 1; i >= 0; --i) {
+    const Joint& j = model.joints[i];
+    ArticulatedBody& b = art[i];
+    const double tau_i = tau[i] - friction_torque(j.friction, dq[i]);
+    double D;
+    if (j.type == JointType::Revolute) {
+      if (j.axis_is_z) {
+        b.Uw = Eigen::Vector3d(b.A[0][2], b.A[1][2], b.A[2][2]);
+        b.Uv = Eigen::Vector3d(b.B[2][0], b.B[2][1], b.B[2][2]);
+        D = b.A[2][2];
+        b.u = tau_i - b.pn.z();
+      } else {
+        const Eigen::Vector3d& a = j.axis;
+        for (int r = 0; r < 3; ++r) {
+          b.Uw[r] = upper(b.A, r, 0) * a.x() + upper(b.A, r, 1) * a.y() + upper(b.A, r, 2) * a.z();
+          b.Uv[r] = b.B[0][r] * a.x() + b.B[1][r] * a.y() + b.B[2][r] * a.z();
+        }
+        D = a.dot(b.Uw);
+        b.u = tau_i - a.dot(b.pn);
+      }
+    } else {
+      if (j.axis_is_z) {
+        b.Uw = Eigen::Vector3d(b.B[0][2], b.B[1][2], b.B[2][2]);
+        b.Uv = Eigen::Vector3d(b.C[0][2], b.C[1][2], b.C[2][2]);
+        D = b.C[2][2];
+        b.u = tau_i - b.pf.z();
+      } else {
+        const Eigen::Vector3d& a = j.axis;
+        for (int r = 0; r < 3; ++r) {
+          b.Uw[r] = b.B[r][0] * a.x() + b.B[r][1] * a.y() + b.B[r][2] * a.z();
+          b.Uv[r] = upper(b.C, r, 0) * a.x() + upper(b.C, r, 1) * a.y() + upper(b.C, r, 2) * a.z();
+        }
+        D = a.dot(b.Uv);
+        b.u = tau_i - a.dot(b.pf);
+      }
+    }
+    b.inv_D = 1.0 / D;
+    if (i == 0) break;
+
+    if (j.type == JointType::Revolute && j.axis_is_z) {
+      project_to_parent<true>(b, data.joint_pose[i], art[i - 1]);
+    } else {
+      project_to_parent<false>(b, data.joint_pose[i], art[i - 1]);
+    }
+  }
+
+  // Pass 3, outwards: accelerations, starting from the base's upward acceleration -g.
+  Eigen::Vector3d dw_prev = Eigen::Vector3d::Zero(), a_prev = Eigen::Vector3d::Zero();
+  for (int i = 0; i < n; ++i) {
+    const Joint& j = model.joints[i];
+    const Pose& X = data.joint_pose[i];
+    const ArticulatedBody& b = art[i];
+    Eigen::Vector3d dw, a;
+    if (i == 0) {  // c = 0 for the first body
+      dw.setZero();
+      a = -(X.R.transpose() * model.gravity);
+    } else {
+      dw = X.R.transpose() * dw_prev + b.cw;
+      a = X.R.transpose() * (a_prev + dw_prev.cross(X.p)) + b.cv;
+    }
+    const double qdd = (b.u - b.Uw.dot(dw) - b.Uv.dot(a)) * b.inv_D;
+    if (j.type == JointType::Revolute) {
+      if (j.axis_is_z) {
+        dw.z() += qdd;
+      } else {
+        dw += j.axis * qdd;
+      }
+    } else {
+      a += j.axis * qdd;
+    }
+    data.ddq[i] = qdd;
+    dw_prev = dw;
+    a_prev = a;
+  }
+}
+
 }  // namespace
 
 double friction_torque(const Friction& friction, double dq) {
@@ -428,7 +813,7 @@ const JointVector& forward_dynamics(const RobotModel& model, RobotData& data,
 
 void dynamics_terms(const RobotModel& model, RobotData& data, const JointVectorRef& q,
                     const JointVectorRef& dq) {
-  update_joint_poses(model, data, q);
+  joint_poses_for_dynamics(model, data, q);
   velocity_terms_and_composites(model, data, dq);
   mass_matrix_from_composites(model, data, true);
   cholesky(data, model.dof);
@@ -438,6 +823,28 @@ const JointVector& forward_dynamics_from_terms(RobotData& data, const JointVecto
   const int n = static_cast<int>(data.ddq.size());
   for (int i = 0; i < n; ++i) data.ddq[i] = tau[i] - data.gravity[i] - data.h[i];
   cholesky_solve(data, n, data.ddq.data());
+  return data.ddq;
+}
+
+const JointVector& joint_poses_and_gravity(const RobotModel& model, RobotData& data,
+                                           const JointVectorRef& q) {
+  joint_poses_for_dynamics(model, data, q);
+  gravity_from_poses(model, data);
+  return data.gravity;
+}
+
+const JointVector& forward_dynamics_aba_from_poses(const RobotModel& model, RobotData& data,
+                                                   const JointVectorRef& dq,
+                                                   const JointVectorRef& tau) {
+  articulated_body_from_poses(model, data, dq, tau);
+  return data.ddq;
+}
+
+const JointVector& forward_dynamics_aba(const RobotModel& model, RobotData& data,
+                                        const JointVectorRef& q, const JointVectorRef& dq,
+                                        const JointVectorRef& tau) {
+  joint_poses_for_dynamics(model, data, q);
+  articulated_body_from_poses(model, data, dq, tau);
   return data.ddq;
 }
 
