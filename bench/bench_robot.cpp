@@ -189,24 +189,6 @@ BENCHMARK(BM_ForwardDynamics);
 void BM_DynamicsTick(benchmark::State& state) { run_dynamics_tick(state, state_pool()); }
 BENCHMARK(BM_DynamicsTick);
 
-// The same tick by the articulated-body algorithm: joint poses and the controller's gravity
-// torques, then the accelerations for one torque.
-[[gnu::noinline]] void run_dynamics_tick_aba(benchmark::State& state, const StatePool& p) {
-  const RobotModel& m = robot();
-  RobotData data(m);
-  std::size_t k = 0;
-  for (auto _ : state) {
-    const JointVector& g = joint_poses_and_gravity(m, data, p.q[k]);
-    benchmark::DoNotOptimize(g);
-    const JointVector& ddq = forward_dynamics_aba_from_poses(m, data, p.dq[k], p.tau[k]);
-    benchmark::DoNotOptimize(ddq);
-    k = (k + 1) & kPoolMask;
-  }
-  state.SetItemsProcessed(state.iterations());
-}
-void BM_DynamicsTickAba(benchmark::State& state) { run_dynamics_tick_aba(state, state_pool()); }
-BENCHMARK(BM_DynamicsTickAba);
-
 // Whole rollouts as the bundle builder runs them (default settings: semi-implicit Euler at the
 // control rate, table.json), replayed from a fixed pool of generated edges. Items are simulated
 // ticks, so items_per_second is ticks per second and instructions per tick is the callgrind

@@ -420,137 +420,14 @@ TEST(Dynamics, SharedTermsDoNotAllocate) {
   EXPECT_EQ(test::allocations.load() - before, 0);
 }
 
-}  // namespace
-}  // namespace lazyboe
-
-namespace lazyboe {
-namespace {
-
-// The articulated-body algorithm and the gravity of the tick path against the reference
-// algorithms: M(q) by CRBA (mass_matrix), g(q) and C(q, dq) dq + tau_f(dq) by recursive
-// Newton-Euler, and Eigen's Cholesky solve, on the chains of DynamicsTermsMatchReferencePaths
-// (the Panda, general axes and prismatic joints, and a prismatic first joint).
-TEST(Dynamics, ArticulatedBodyMatchesReferencePaths) {
-  RobotModel prismatic_first = mixed_chain();
-  prismatic_first.joints[0].type = JointType::Prismatic;
-  prismatic_first.joints[0].axis = Eigen::Vector3d(0.6, 0, 0.8);
-  prismatic_first.joints[0].axis_is_z = false;
-  prismatic_first.q_min[0] = prismatic_first.joints[0].lower = -0.3;
-  prismatic_first.q_max[0] = prismatic_first.joints[0].upper = 0.3;
-  std::mt19937_64 rng(22);
-  for (const RobotModel& robot : {test::panda(), mixed_chain(), prismatic_first}) {
-    RobotData aba(robot), reference(robot);
-    const int n = robot.dof;
-    for (int trial = 0; trial < 500; ++trial) {
-      const State s = random_state(robot, rng);
-      JointVector tau(n);
-      for (int i = 0; i < n; ++i)
-        tau[i] = std::uniform_real_distribution<double>(-1, 1)(rng) * robot.tau_max[i];
-
-      const JointMatrix M = mass_matrix(robot, reference, s.q);
-      const JointVector g = gravity_torques(robot, reference, s.q);
-      const JointVector h = rnea(robot, reference, s.q, s.dq, JointVector::Zero(n), false, true);
-      const JointVector expected = Eigen::MatrixXd(M).llt().solve(tau - g - h);
-
-      // The tick's two calls: gravity (and poses) first, then the accelerations.
-      const JointVector gravity = joint_poses_and_gravity(robot, aba, s.q);
-      EXPECT_LT((gravity - g).norm(), 1e-10 * std::max(1.0, g.norm())) << "trial " << trial;
-      const JointVector ddq = forward_dynamics_aba_from_poses(robot, aba, s.dq, tau);
-      EXPECT_LT((ddq - expected).norm(), 1e-10 * std::max(1.0, expected.norm()))
-          << "trial " << trial;
-      // The one-call form is the same computation.
-      EXPECT_EQ(forward_dynamics_aba(robot, aba, s.q, s.dq, tau), ddq);
-      // Inverse dynamics takes the accelerations back to the torques.
-      const JointVector tau_back = inverse_dynamics(robot, reference, s.q, s.dq, ddq);
-      EXPECT_LT((tau_back - tau).norm(), 1e-9 * std::max(1.0, tau.norm())) << "trial " << trial;
-    }
-  }
-}
-
-// One joint: ddq = (tau - g - h) / M.
-TEST(Dynamics, ArticulatedBodySingleJoint) {
-  RobotModel robot = test::panda();
-  robot.dof = 1;
-  robot.joints.resize(1);
-  robot.bodies.resize(1);
-  RobotData data(robot);
-  JointVector q(1), dq(1), tau(1);
-  q << 0.4;
-  dq << 0.7;
-  tau << 2.0;
-  const JointVector ddq = forward_dynamics_aba(robot, data, q, dq, tau);
-  const JointMatrix M = mass_matrix_from_jacobians(robot, q);
-  const JointVector g = gravity_torques(robot, data, q);
-  const JointVector h = rnea(robot, data, q, dq, JointVector::Zero(1), false, true);
-  EXPECT_NEAR(ddq[0], (tau[0] - g[0] - h[0]) / M(0, 0), 1e-12 * std::abs(ddq[0]));
-}
-
-TEST(Dynamics, ArticulatedBodyDoesNotAllocate) {
-  const RobotModel& robot = test::panda();
-  RobotData data(robot);
-  std::mt19937_64 rng(23);
-  const State s = random_state(robot, rng);
-  const JointVector tau = JointVector::Constant(7, 1.0);
-  const long before = test::allocations.load();
-  for (int k = 0; k < 10; ++k) {
-    joint_poses_and_gravity(robot, data, s.q);
-    forward_dynamics_aba_from_poses(robot, data, s.dq, tau);
-    forward_dynamics_aba(robot, data, s.q, s.dq, tau);
-  }
-  EXPECT_EQ(test::allocations.load() - before, 0);
-}
-
-}  // namespace
-}  // namespace lazyboe
-
-namespace lazyboe {
-namespace {
-
-// dynamics_terms computes the joint poses with its own sin and cos (joint_sincos in
-// dynamics.cpp); they agree with update_joint_poses (std::sin, std::cos) to about 1 ulp, over
-// every quadrant, at the quadrant boundaries, and beyond the range where it falls back to libm.
-TEST(Dynamics, DynamicsJointPosesMatchKinematics) {
-  const RobotModel& robot = test::panda();
-  RobotData terms(robot), kinematics(robot);
-  std::mt19937_64 rng(24);
-  std::uniform_real_distribution<double> angle(-12.0, 12.0);
-  std::vector<double> values = {0.0, -0.0, 1e-300, -1e-300, 1e-9, 0.5, 1e6, -3e7};
-  for (int k = -16; k <= 16; ++k) {
-    for (double d : {-1e-12, 0.0, 1e-12}) values.push_back(k * M_PI / 4 + d);
-  }
-  for (int trial = 0; trial < 20000; ++trial) values.push_back(angle(rng));
-  const JointVector dq = JointVector::Zero(robot.dof);
-  double worst = 0;
-  for (std::size_t v = 0; v < values.size(); v += robot.dof) {
-    JointVector q(robot.dof);
-    for (int i = 0; i < robot.dof; ++i) q[i] = values[(v + i) % values.size()];
-    dynamics_terms(robot, terms, q, dq);
-    update_joint_poses(robot, kinematics, q);
-    for (int i = 0; i < robot.dof; ++i) {
-      const double diff =
-          (terms.joint_pose[i].R - kinematics.joint_pose[i].R).cwiseAbs().maxCoeff();
-      worst = std::max(worst, diff);
-      EXPECT_EQ(terms.joint_pose[i].p, kinematics.joint_pose[i].p);
-    }
-  }
-  EXPECT_LT(worst, 4.5e-16);  // 2 ulp of 1
-}
-
-}  // namespace
-}  // namespace lazyboe
-
-namespace lazyboe {
-namespace {
-
-// A five-joint chain (the mixed chain without its last two joints): the shared terms and the
-// articulated-body algorithm for a chain other than the seven joints above, against the
-// reference paths.
+// A five-joint chain (the mixed chain without its last two joints): the shared terms of the
+// simulator tick for a chain other than the seven joints above, against the reference paths.
 TEST(Dynamics, FiveJointChainMatchesReferencePaths) {
   RobotModel robot = mixed_chain();
   robot.dof = 5;
   robot.joints.resize(5);
   robot.bodies.resize(5);
-  RobotData terms(robot), aba(robot), reference(robot);
+  RobotData terms(robot), reference(robot);
   std::mt19937_64 rng(25);
   for (int trial = 0; trial < 200; ++trial) {
     const State s = random_state(robot, rng);
@@ -568,12 +445,6 @@ TEST(Dynamics, FiveJointChainMatchesReferencePaths) {
     EXPECT_LT((terms.h - h).norm(), 1e-10 * std::max(1.0, h.norm())) << "trial " << trial;
     const JointVector ddq = forward_dynamics_from_terms(terms, tau);
     EXPECT_LT((ddq - expected).norm(), 1e-10 * std::max(1.0, expected.norm())) << "trial " << trial;
-
-    const JointVector gravity = joint_poses_and_gravity(robot, aba, s.q);
-    EXPECT_LT((gravity - g).norm(), 1e-10 * std::max(1.0, g.norm())) << "trial " << trial;
-    const JointVector ddq_aba = forward_dynamics_aba_from_poses(robot, aba, s.dq, tau);
-    EXPECT_LT((ddq_aba - expected).norm(), 1e-10 * std::max(1.0, expected.norm()))
-        << "trial " << trial;
   }
 }
 

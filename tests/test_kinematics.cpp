@@ -2,10 +2,14 @@
 // modified Denavit-Hartenberg parameters of the Panda, evaluated here without the URDF.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
+#include <string>
+#include <vector>
 
 #include "robot/kinematics.h"
+#include "robot/sincos.h"
 #include "test_util.h"
 
 namespace lazyboe {
@@ -83,6 +87,32 @@ TEST(Kinematics, EveryLinkFollowsItsParentJoint) {
     const Eigen::Vector3d z2 = link_pose(robot, data2, link).R.col(2);
     EXPECT_LT((z1 - z2).norm(), 1e-12);
   }
+}
+
+// The joint poses' inline sin and cos (robot/sincos.h) against libm, in units in the last place
+// of libm's value: over every quadrant, at the quadrant boundaries, for tiny angles, and beyond
+// the range where it falls back to libm.
+TEST(Kinematics, JointSinCosIsWithinTwoUlpOfLibm) {
+  std::vector<double> values = {0.0, -0.0, 1e-300, -1e-300, 1e-9, 0.5, 1e6, -3e7, 99999.9};
+  for (int k = -16; k <= 16; ++k) {
+    for (double d : {-1e-12, 0.0, 1e-12}) values.push_back(k * M_PI / 4 + d);
+  }
+  std::mt19937_64 rng(24);
+  std::uniform_real_distribution<double> angle(-12.0, 12.0);
+  for (int trial = 0; trial < 100000; ++trial) values.push_back(angle(rng));
+  auto ulps = [](double got, double expected) {
+    const double ulp = std::nextafter(std::abs(expected), INFINITY) - std::abs(expected);
+    return std::abs(got - expected) / ulp;
+  };
+  double worst = 0;
+  for (double x : values) {
+    double s, c;
+    joint_sincos(x, s, c);
+    worst = std::max({worst, ulps(s, std::sin(x)), ulps(c, std::cos(x))});
+    ASSERT_LE(ulps(s, std::sin(x)), 2.0) << "sin " << x;
+    ASSERT_LE(ulps(c, std::cos(x)), 2.0) << "cos " << x;
+  }
+  RecordProperty("worst_ulps", std::to_string(worst));
 }
 
 }  // namespace

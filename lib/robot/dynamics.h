@@ -41,27 +41,10 @@ const JointVector& forward_dynamics(const RobotModel& model, RobotData& data,
 // (data.h). A simulator tick then gets ddq for its controller torque from
 // forward_dynamics_from_terms without a second pass. The velocity terms come from a
 // Newton-Euler pass fused with the composite-inertia pass; rnea() and gravity_torques() stay
-// the separate reference algorithms. The joint poses come from the same formulas as
-// update_joint_poses but with an inline sin/cos (within about 1 ulp of libm's).
+// the separate reference algorithms.
 void dynamics_terms(const RobotModel& model, RobotData& data, const JointVectorRef& q,
                     const JointVectorRef& dq);
 const JointVector& forward_dynamics_from_terms(RobotData& data, const JointVectorRef& tau);
-
-// Forward dynamics by Featherstone's articulated-body algorithm (O(n), no mass matrix):
-// ddq = M^-1 (tau - C dq - g - tau_f) in data.ddq, with gravity as an upward acceleration of the
-// base. For a simulator tick, joint_poses_and_gravity gives the controller g(q) (data.gravity,
-// from the subtrees' composite masses) and leaves the joint poses at q in data.joint_pose, which
-// forward_dynamics_aba_from_poses then uses for the accelerations under the controller's
-// torque. Not the simulator's path: for the 7-DOF Panda it takes more instructions per tick
-// than dynamics_terms (docs/performance.md); it stays as an O(n) alternative and cross-check.
-const JointVector& forward_dynamics_aba(const RobotModel& model, RobotData& data,
-                                        const JointVectorRef& q, const JointVectorRef& dq,
-                                        const JointVectorRef& tau);
-const JointVector& joint_poses_and_gravity(const RobotModel& model, RobotData& data,
-                                           const JointVectorRef& q);
-const JointVector& forward_dynamics_aba_from_poses(const RobotModel& model, RobotData& data,
-                                                   const JointVectorRef& dq,
-                                                   const JointVectorRef& tau);
 
 double kinetic_energy(const RobotModel& model, RobotData& data, const JointVectorRef& q,
                       const JointVectorRef& dq);

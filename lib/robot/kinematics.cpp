@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "robot/sincos.h"
+
 namespace lazyboe {
 
 RobotData::RobotData(const RobotModel& model)
@@ -28,7 +30,8 @@ void update_joint_poses(const RobotModel& model, RobotData& data, const JointVec
     Pose& X = data.joint_pose[i];
     if (j.type == JointType::Revolute && j.axis_is_z) {
       // origin.R * Rz(q): only the first two columns mix.
-      const double c = std::cos(q[i]), s = std::sin(q[i]);
+      double s, c;
+      joint_sincos(q[i], s, c);
       X.R.col(0) = c * j.origin.R.col(0) + s * j.origin.R.col(1);
       X.R.col(1) = c * j.origin.R.col(1) - s * j.origin.R.col(0);
       X.R.col(2) = j.origin.R.col(2);
