@@ -18,6 +18,7 @@
 #include "robot/dynamics.h"
 #include "robot/kinematics.h"
 #include "robot/robot_model.h"
+#include "sim/rollout_pool.h"
 #include "sim/simulator.h"
 
 namespace {
@@ -238,6 +239,35 @@ const EdgePool& edge_pool() {
 }
 void BM_SimulateEdge(benchmark::State& state) { run_simulate(state, edge_pool()); }
 BENCHMARK(BM_SimulateEdge);
+
+// The same rollouts in waves on a RolloutPool, as BoE and LazyBoE run an expansion's rollouts
+// (--sim-threads): args are threads and wave size. Items are rollouts, and the time is wall
+// time, so threads 2 against 1 at the same wave size is the pool's speed-up.
+void BM_RolloutPool(benchmark::State& state) {
+  const EdgePool& edges = edge_pool();
+  const int dof = robot().dof;
+  RolloutPool pool(edges.sim, static_cast<int>(state.range(0)));
+  const int wave = static_cast<int>(state.range(1));
+  std::vector<RolloutTask> tasks(wave);
+  std::vector<RolloutResult> results(wave);
+  std::size_t k = 0;
+  for (auto _ : state) {
+    for (RolloutTask& t : tasks) {
+      const EdgeAttempt& e = edges.edges[k];
+      t = {e.q0.data(), CommandProfile{e.knots.data(), static_cast<int>(e.knots.size() / dof), dof,
+                                       e.command_duration}};
+      k = (k + 1) % edges.edges.size();
+    }
+    pool.run(tasks.data(), results.data(), wave);
+    benchmark::DoNotOptimize(results.data());
+  }
+  state.SetItemsProcessed(state.iterations() * wave);
+}
+BENCHMARK(BM_RolloutPool)
+    ->ArgsProduct({{1, 2}, {2, 16}})
+    ->ArgNames({"threads", "wave"})
+    ->UseRealTime()
+    ->Unit(benchmark::kMillisecond);
 
 // ---- Collision: forward kinematics + transform update + self and environment check -----------
 

@@ -519,8 +519,9 @@ std::vector<json> quick_queries() {
 }
 
 const ToolRun& deterministic_run() {
-  static const ToolRun run = run_batch("deterministic", deterministic_queries(),
-                                       {"--trajectories", "inline", "--jobs", "1", "--quiet"});
+  static const ToolRun run =
+      run_batch("deterministic", deterministic_queries(),
+                {"--trajectories", "inline", "--jobs", "1", "--sim-threads", "1", "--quiet"});
   return run;
 }
 
@@ -751,6 +752,75 @@ TEST(Query, FixedSeedAndOneJobGiveIdenticalResults) {
         << "trajectories differ";
     // Everything else too, but the wall-clock time.
     EXPECT_EQ(timeless(x).dump(), timeless(y).dump());
+  }
+}
+
+// Rollouts of one query run in parallel (--sim-threads) give the same answers as one thread:
+// the reference run above simulates everything in turn. Three threads on any machine: the
+// waves of rollouts then differ from one and two threads.
+TEST(Query, ParallelRolloutsGiveTheSameAnswersAsOneThread) {
+  const std::vector<json> queries = deterministic_queries();
+  const ToolRun& one = deterministic_run();
+  expect_batch_ran(one, queries.size());
+  const ToolRun three =
+      run_batch("deterministic", queries,
+                {"--trajectories", "inline", "--jobs", "1", "--sim-threads", "3", "--quiet"});
+  expect_batch_ran(three, queries.size());
+  const ToolRun nested =
+      run_batch("deterministic", queries,
+                {"--trajectories", "inline", "--jobs", "2", "--sim-threads", "2", "--quiet"});
+  expect_batch_ran(nested, queries.size());
+  for (size_t i = 0; i < queries.size(); ++i) {
+    SCOPED_TRACE(queries[i]["id"].get<std::string>());
+    expect_solved(three.results[i], "--sim-threads 3");
+    EXPECT_EQ(timeless(one.results[i]).dump(), timeless(three.results[i]).dump());
+    EXPECT_EQ(timeless(one.results[i]).dump(), timeless(nested.results[i]).dump());
+  }
+}
+
+// Bad --sim-threads values: one line naming the option, before the bundle is even opened.
+TEST(Query, BadSimThreadsAreRefusedWithOneLine) {
+  const Fixture& f = fixture();
+  const std::string good =
+      write_temp_file("simthreads/one.jsonl", query("q", f.a, f.b, "boe", 1, true).dump() + "\n");
+  for (const std::string bad : {"-1", "two", "2000"}) {
+    SCOPED_TRACE(bad);
+    const ToolRun t = query_tool({"--bundle", f.path, "--queries", good, "--sim-threads", bad});
+    EXPECT_NE(t.r.exit_code, 0) << describe(t.r);
+    EXPECT_EQ(count_lines(t.r.err), 1) << describe(t.r);
+    EXPECT_TRUE(contains(t.r.err, "--sim-threads")) << describe(t.r);
+    EXPECT_FALSE(contains(t.r.err, "loaded")) << describe(t.r);
+    EXPECT_TRUE(t.r.out.empty()) << describe(t.r);
+  }
+}
+
+// Through the library: the pool does run rollouts, and the search uses them exactly as its own.
+TEST(Query, ARolloutPoolChangesNothingButWhoSimulates) {
+  const Fixture& f = fixture();
+  const PlanningContext context{f.sim, &f.view, &f.index};
+  for (const std::string planner : {"lazyboe", "boe"}) {
+    SCOPED_TRACE(planner);
+    PlanningProblem p = library_problem(f, f.a, f.c, planner, 10);
+    p.params.stop_at_first = true;
+    p.params.seed = 7;
+    SimulatorWorkspace ws(f.sim);
+    const PlanResult alone = plan(context, ws, p);
+    RolloutPool pool(f.sim, 3);
+    const PlanResult pooled = plan(context, ws, p, &pool);
+    ASSERT_TRUE(alone.success) << alone.failure;
+    EXPECT_GT(pool.rollouts(), 0u) << "the search did not use the pool";
+    // Unused rollouts are only those of the last wave, when the search stops.
+    EXPECT_LE(pool.rollouts(), pooled.counters.simulations + kWavePerThread * pool.threads() - 1);
+    EXPECT_EQ(pooled.success, alone.success);
+    EXPECT_EQ(pooled.n_solutions, alone.n_solutions);
+    EXPECT_EQ(pooled.best_cost, alone.best_cost);
+    EXPECT_EQ(pooled.counters.nodes, alone.counters.nodes);
+    EXPECT_EQ(pooled.counters.simulations, alone.counters.simulations);
+    EXPECT_EQ(pooled.counters.lazy_edges, alone.counters.lazy_edges);
+    EXPECT_EQ(pooled.counters.collision_checks, alone.counters.collision_checks);
+    ASSERT_EQ(pooled.best_path.size(), alone.best_path.size());
+    for (size_t s = 0; s < alone.best_path.size(); ++s)
+      EXPECT_EQ(pooled.best_path[s].bundle_edge, alone.best_path[s].bundle_edge) << "step " << s;
   }
 }
 
@@ -1223,7 +1293,6 @@ TEST(Query, StartOrGoalOutsideTheCoverageFailsWithAReason) {
             << "[ reason  ] far goal:  "
             << (t.results.size() < 2 ? "" : t.results[1].value("failure", "")) << "\n";
 }
-
 
 // An edge whose stored end lies at its own start can be taken lazily again and again from that
 // end, with the heuristic unchanged. Such a chain must end (a tie counts as the heuristic

@@ -9,6 +9,8 @@
 
 #include "alloc_counter.h"
 #include "bundle/builder.h"
+#include "common/error.h"
+#include "sim/rollout_pool.h"
 #include "sim/simulator.h"
 #include "test_util.h"
 
@@ -110,6 +112,52 @@ TEST(Simulator, ValidRolloutsStartAndEndAtRestAndStayCollisionFree) {
     }
   }
   EXPECT_GT(valid, 40);
+}
+
+// A pool's rollouts are the simulator's, each in its own slot, whatever the thread count and
+// however often the pool is reused; some of these attempts are invalid (collisions, limits), so
+// early exits are mixed in.
+TEST(RolloutPool, GivesEachTaskTheSimulatorsResultInItsSlot) {
+  Scene scene("table");
+  SimulatorWorkspace ws(scene.sim);
+  const BuildSettings settings = default_settings(scene.robot);
+  std::vector<EdgeAttempt> attempts(24);
+  std::vector<RolloutTask> tasks;
+  for (size_t a = 0; a < attempts.size(); ++a) {
+    generate_edge(scene.sim, ws, settings, a, attempts[a]);
+    tasks.push_back({attempts[a].q0.data(), view(attempts[a], 7)});
+  }
+  std::vector<RolloutResult> expected;
+  int invalid = 0;
+  for (const RolloutTask& t : tasks) {
+    expected.push_back(
+        simulate(scene.sim, ws, Eigen::Map<const Eigen::VectorXd>(t.q0, 7), t.command));
+    invalid += !expected.back().valid();
+  }
+  for (int threads : {1, 2, 5}) {
+    SCOPED_TRACE(threads);
+    RolloutPool pool(scene.sim, threads);
+    // One pool, batch after batch (its workers wait between them), of several sizes.
+    uint64_t run = 0;
+    for (int count : {24, 1, 0, 7, 24, 2}) {
+      SCOPED_TRACE(count);
+      std::vector<RolloutResult> got(count);
+      const size_t first = count == 24 ? 0 : 24 - count;  // the short batches: the last tasks
+      pool.run(tasks.data() + first, got.data(), count);
+      run += count;
+      EXPECT_EQ(pool.rollouts(), run);
+      for (int i = 0; i < count; ++i) {
+        const size_t k = first + i;
+        EXPECT_EQ(got[i].status, expected[k].status) << "task " << k;
+        EXPECT_EQ(got[i].ticks, expected[k].ticks) << "task " << k;
+        EXPECT_EQ(got[i].collision_checks, expected[k].collision_checks) << "task " << k;
+        EXPECT_EQ(got[i].path_length, expected[k].path_length) << "task " << k;
+        EXPECT_TRUE(got[i].qf == expected[k].qf) << "task " << k;
+      }
+    }
+  }
+  EXPECT_GT(invalid, 0) << "no invalid rollout among the tasks: early exits untested";
+  EXPECT_THROW(RolloutPool(scene.sim, 0), Error);  // no threads
 }
 
 TEST(Simulator, EndStateComesFromTheDynamics) {

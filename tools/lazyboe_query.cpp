@@ -9,6 +9,7 @@
 #include <fstream>
 #include <iostream>
 #include <map>
+#include <memory>
 
 #include "common/histogram.h"
 #include "io/query_io.h"
@@ -32,7 +33,7 @@ int main(int argc, char** argv) {
   CLI::App app{"Answer a batch of planning queries (JSON Lines) on an edge bundle."};
   std::string bundle_path, queries_path, out_path = "-", trajectories = "none", trajectory_dir;
   std::string robot_path, env_path;
-  int jobs = 1;
+  int jobs = 1, sim_threads = 0;
   double sample_interval = 0.01;
   bool no_mmap = false, quiet = false;
   app.add_option("--bundle", bundle_path,
@@ -46,6 +47,11 @@ int main(int argc, char** argv) {
   app.add_option("--jobs", jobs, "Queries planned in parallel")
       ->capture_default_str()
       ->check(whole_number(false));
+  app.add_option("--sim-threads", sim_threads,
+                 "Threads simulating one BoE/LazyBoE query's edges in parallel (the answers do "
+                 "not depend on it); 0: the cores left per job")
+      ->capture_default_str()
+      ->check(whole_number(true));
   app.add_option("--trajectories", trajectories,
                  "none, inline (in each result) or csv (files in --trajectory-dir)")
       ->capture_default_str();
@@ -70,6 +76,8 @@ int main(int argc, char** argv) {
     } else if (trajectories != "none") {
       fail("--trajectories", "expected none, inline or csv");
     }
+    if (sim_threads > 1024)
+      fail("--sim-threads", "at most 1024, got " + std::to_string(sim_threads));
     const PlanningSession session(bundle_path, !no_mmap, robot_path, env_path);
     const BundleView& bundle = session.bundle;
     const RobotModel& robot = session.scene.robot;
@@ -100,15 +108,18 @@ int main(int argc, char** argv) {
     }
     std::ostream& out = to_stdout ? std::cout : file_out;
 
+    if (sim_threads == 0) sim_threads = std::max(1, omp_get_num_procs() / jobs);
+
     std::vector<Outcome> outcomes;
-    auto answer = [&](const std::string& text, int line, SimulatorWorkspace& ws) {
+    auto answer = [&](const std::string& text, int line, SimulatorWorkspace& ws,
+                      RolloutPool& pool) {
       std::string id;
       Outcome o;
       nlohmann::json j;
       try {
         const Query q = parse_query(text, line, robot, sim, ws, defaults, id);
         o.planner = q.problem.params.planner;
-        const PlanResult r = plan(context, ws, q.problem);
+        const PlanResult r = plan(context, ws, q.problem, &pool);
         Trajectory traj;
         bool have = false;
         if (r.success) {
@@ -134,12 +145,13 @@ int main(int argc, char** argv) {
     if (queries_path == "-") {
       // Streaming: one result per query as soon as it is ready.
       SimulatorWorkspace ws(sim);
+      RolloutPool pool(sim, sim_threads);
       std::string text;
       int line = 0;
       while (std::getline(std::cin, text)) {
         ++line;
         if (text.find_first_not_of(" \t\r") == std::string::npos) continue;
-        auto [json, o] = answer(text, line, ws);
+        auto [json, o] = answer(text, line, ws, pool);
         out << json << "\n" << std::flush;
         outcomes.push_back(o);
       }
@@ -153,10 +165,15 @@ int main(int argc, char** argv) {
       }
       outcomes.resize(lines.size());
       std::vector<SimulatorWorkspace> workspaces;
-      for (int t = 0; t < jobs; ++t) workspaces.emplace_back(sim);
+      std::vector<std::unique_ptr<RolloutPool>> pools;  // not movable: they own threads
+      for (int t = 0; t < jobs; ++t) {
+        workspaces.emplace_back(sim);
+        pools.push_back(std::make_unique<RolloutPool>(sim, sim_threads));
+      }
 #pragma omp parallel for num_threads(jobs) schedule(dynamic, 1) ordered
       for (long k = 0; k < static_cast<long>(lines.size()); ++k) {
-        auto [json, o] = answer(lines[k].second, lines[k].first, workspaces[omp_get_thread_num()]);
+        const int t = omp_get_thread_num();
+        auto [json, o] = answer(lines[k].second, lines[k].first, workspaces[t], *pools[t]);
         outcomes[k] = o;
 #pragma omp ordered
         { out << json << "\n" << std::flush; }

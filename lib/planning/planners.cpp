@@ -48,10 +48,14 @@ class SearchState {
   }
 
   RolloutResult simulate_from(const JointVectorRef& q, const CommandProfile& profile) {
-    ++result_.counters.simulations;
     const RolloutResult r = simulate(ctx_.sim, ws_, q, profile);
-    result_.counters.collision_checks += r.collision_checks;
+    count(r);
     return r;
+  }
+  // Counts a rollout the search uses (run here, or ahead of time by a RolloutPool).
+  void count(const RolloutResult& r) {
+    ++result_.counters.simulations;
+    result_.counters.collision_checks += r.collision_checks;
   }
 
   // A real node inside the goal region: a solution.
@@ -88,8 +92,13 @@ JointVector row(const double* p, int n) { return Eigen::Map<const Eigen::VectorX
 class BundleSearch {
  public:
   BundleSearch(const PlanningContext& ctx, SimulatorWorkspace& ws, const PlanningProblem& p,
-               bool lazy)
-      : ctx_(ctx), s_(ctx, ws, p), lazy_(lazy), theta_(p.params.theta), rng_(p.params.seed, 0) {}
+               bool lazy, RolloutPool* pool)
+      : ctx_(ctx),
+        s_(ctx, ws, p),
+        lazy_(lazy),
+        theta_(p.params.theta),
+        rng_(p.params.seed, 0),
+        pool_(pool && pool->threads() > 1 ? pool : nullptr) {}
 
   PlanResult run() {
     const BundleView& b = *ctx_.bundle;
@@ -152,18 +161,28 @@ class BundleSearch {
       // Most promising edges first (heuristic at their stored end): the same edges are taken,
       // but a goal reached in this expansion is reached sooner.
       order_by_promise(neighbours, n);
-      for (const auto& [e, key] : neighbours) {
-        (void)key;
+      // P_select draws for the whole neighbourhood up front (so that the rollouts of a real
+      // node can be run ahead, in parallel; see rollout_from).
+      const bool lazy_search = lazy_ && !exhaustive_;
+      take_lazy_.assign(neighbours.size(), 0);
+      if (lazy_search) {
+        for (size_t k = 0; k < neighbours.size(); ++k) {
+          const uint32_t e = neighbours[k].first;
+          take_lazy_[k] = rng_.uniform() < (1 - b.p_collision(e)) * b.p_lazy_prop(e);
+        }
+      }
+      begin_expansion(v, neighbours);
+      for (size_t k = 0; k < neighbours.size(); ++k) {
+        const uint32_t e = neighbours[k].first;
         if (s_.should_stop() || dead(v)) break;
-        if (lazy_ && !exhaustive_) {
-          const double p_select = (1 - b.p_collision(e)) * b.p_lazy_prop(e);
-          if (rng_.uniform() < p_select) {
-            take_lazily(v, e, n);
+        if (lazy_search) {
+          if (take_lazy_[k]) {
+            take_lazily(v, e, n, k);
             continue;
           }
           if (s_.nodes()[v].lazy && !realize(v)) break;  // simulate the lazy chain up to v first
         }
-        simulate_edge(v, e);
+        simulate_edge(v, e, k);
       }
     }
     PlanResult& r = s_.result();
@@ -218,10 +237,67 @@ class BundleSearch {
     s_.solution(node, [this](int u) { return path_to(u); });
   }
 
-  void simulate_edge(int v, uint32_t e) {
+  // ---- Rollouts of the expanded node, ahead of time ----
+  // Once the expanded node v is real, every rollout the rest of its expansion needs starts at
+  // v's state: the edges not taken lazily (and not simulated from v before), and the lazy ones
+  // whose stored end is in the goal region (take_lazily simulates them at once). Those are
+  // independent, so with a RolloutPool they run in waves of kWavePerThread per thread, in
+  // expansion order, and the search consumes them in that order exactly as if it had run them
+  // itself: its results do not depend on the number of threads. Only when the search stops
+  // (first solution, budget) can the rest of a wave go unused; counters count used rollouts.
+
+  void begin_expansion(int v, const std::vector<std::pair<uint32_t, double>>& neighbours) {
+    expanding_ = v;
+    expansion_ = &neighbours;
+    ahead_.assign(neighbours.size(), Ahead::Unplanned);
+    planned_from_ = -1;
+  }
+
+  bool needs_rollout_from_real(int v, size_t k) {
+    const uint32_t e = (*expansion_)[k].first;
+    if (!take_lazy_[k]) return !simulated_.count((static_cast<uint64_t>(v) << 32) | e);
+    return s_.in_goal(s_.heuristic(row(ctx_.bundle->qf(e), ctx_.bundle->dof())));
+  }
+
+  // The rollout of neighbour k's edge from the expanded node v, which is real.
+  RolloutResult rollout_from(int v, size_t k) {
+    const uint32_t e = (*expansion_)[k].first;
+    if (!pool_ || v != expanding_)
+      return s_.simulate_from(s_.nodes()[v].q, ctx_.bundle->command(e));
+    if (planned_from_ < 0) {
+      // v became real at neighbour k: from here on, mark which neighbours need a rollout.
+      planned_from_ = static_cast<long>(k);
+      for (size_t j = k; j < ahead_.size(); ++j)
+        ahead_[j] = needs_rollout_from_real(v, j) ? Ahead::Needed : Ahead::None;
+    }
+    if (ahead_[k] != Ahead::Done) {
+      // A wave: this rollout and the next ones needed.
+      wave_.clear();
+      tasks_.clear();
+      for (size_t j = k;
+           j < ahead_.size() && static_cast<int>(wave_.size()) < kWavePerThread * pool_->threads();
+           ++j) {
+        if (j != k && ahead_[j] != Ahead::Needed) continue;
+        wave_.push_back(j);
+        tasks_.push_back({s_.nodes()[v].q.data(), ctx_.bundle->command((*expansion_)[j].first)});
+      }
+      if (results_.size() < ahead_.size()) results_.resize(ahead_.size());
+      wave_results_.resize(wave_.size());
+      pool_->run(tasks_.data(), wave_results_.data(), static_cast<int>(wave_.size()));
+      for (size_t w = 0; w < wave_.size(); ++w) {
+        results_[wave_[w]] = wave_results_[w];
+        ahead_[wave_[w]] = Ahead::Done;
+      }
+    }
+    ahead_[k] = Ahead::None;  // used
+    s_.count(results_[k]);
+    return results_[k];
+  }
+
+  void simulate_edge(int v, uint32_t e, size_t k) {
     // The same edge from the same real node always gives the same rollout: never twice.
     if (!simulated_.insert((static_cast<uint64_t>(v) << 32) | e).second) return;
-    const RolloutResult r = s_.simulate_from(s_.nodes()[v].q, ctx_.bundle->command(e));
+    const RolloutResult r = rollout_from(v, k);
     if (!r.valid()) return;
     Node c;
     c.q = r.qf;
@@ -237,7 +313,7 @@ class BundleSearch {
     }
   }
 
-  void take_lazily(int v, uint32_t e, int n) {
+  void take_lazily(int v, uint32_t e, int n, size_t k) {
     const BundleView& b = *ctx_.bundle;
     ++s_.result().counters.lazy_edges;
     Node c;
@@ -254,7 +330,7 @@ class BundleSearch {
     // whose stored end lies within theta/2 of its own start can be taken again from that end,
     // and a chain without progress would otherwise grow forever for free.
     if (s_.in_goal(c.h)) {
-      realize(id);
+      realize(id, k);
     } else if (c.h >= s_.nodes()[v].h && s_.nodes()[v].lazy) {
       if (realize(v)) push(id);
     } else {
@@ -264,14 +340,17 @@ class BundleSearch {
 
   // Simulates the lazy chain ending at `x` from its last simulated ancestor. Nodes that pass
   // become real (their state the simulated end); the first failure kills the rest of the chain.
-  bool realize(int x) {
+  // `k`: x is the lazy child of the expanded node for its neighbour k (a one-edge chain).
+  bool realize(int x, long k = -1) {
     std::vector<int> chain;
     for (int u = x; s_.nodes()[u].lazy; u = s_.nodes()[u].parent) chain.push_back(u);
     std::reverse(chain.begin(), chain.end());
     for (int u : chain) {
       Node& node = s_.nodes()[u];
       const Node& parent = s_.nodes()[node.parent];
-      const RolloutResult r = s_.simulate_from(parent.q, ctx_.bundle->command(node.edge));
+      const RolloutResult r = k >= 0 && chain.size() == 1 && node.parent == expanding_
+                                  ? rollout_from(node.parent, static_cast<size_t>(k))
+                                  : s_.simulate_from(parent.q, ctx_.bundle->command(node.edge));
       if (!r.valid()) {
         s_.nodes()[u].dead = true;
         return false;
@@ -299,6 +378,17 @@ class BundleSearch {
   Random rng_;
   std::priority_queue<std::pair<double, int>, std::vector<std::pair<double, int>>, std::greater<>>
       open_;
+  // The expansion in progress: its node, neighbours, P_select draws, rollouts run ahead.
+  enum class Ahead : uint8_t { Unplanned, None, Needed, Done };
+  RolloutPool* pool_;  // null: every rollout runs when it is needed, on the search's workspace
+  int expanding_ = -1;
+  const std::vector<std::pair<uint32_t, double>>* expansion_ = nullptr;
+  std::vector<char> take_lazy_;
+  std::vector<Ahead> ahead_;
+  long planned_from_ = -1;
+  std::vector<size_t> wave_;
+  std::vector<RolloutTask> tasks_;
+  std::vector<RolloutResult> results_, wave_results_;
 };
 
 // ---- RRT and SST ----------------------------------------------------------------------------
@@ -449,8 +539,8 @@ class TreeSearch {
 
 }  // namespace
 
-PlanResult plan(const PlanningContext& ctx, SimulatorWorkspace& ws,
-                const PlanningProblem& problem) {
+PlanResult plan(const PlanningContext& ctx, SimulatorWorkspace& ws, const PlanningProblem& problem,
+                RolloutPool* pool) {
   const std::string& name = problem.params.planner;
   if (name == "boe" || name == "lazyboe") {
     if (!ctx.bundle || !ctx.index) fail("planner", name + " needs an edge bundle");
@@ -459,7 +549,7 @@ PlanResult plan(const PlanningContext& ctx, SimulatorWorkspace& ws,
            "has no complete perturbation analysis, which lazyboe needs (run lazyboe-perturb)");
     }
     if (!(problem.params.theta > 0)) fail("theta", "must be > 0");
-    return BundleSearch(ctx, ws, problem, name == "lazyboe").run();
+    return BundleSearch(ctx, ws, problem, name == "lazyboe", pool).run();
   }
   if (name == "rrt" || name == "sst") {
     PlanningProblem p = problem;

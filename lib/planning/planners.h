@@ -12,12 +12,22 @@
 #pragma once
 
 #include "planning/problem.h"
+#include "sim/rollout_pool.h"
 
 namespace lazyboe {
 
 // Runs the planner named in problem.params.planner within its budget. Throws Error for an
 // unknown planner or a planner that needs what the context lacks (a bundle, perturbation data).
+// With a pool of several threads, BoE and LazyBoE run the independent rollouts of an expansion
+// in parallel, in waves of up to kWavePerThread * pool->threads(); the result is the same for
+// any number of threads (but the time it takes). Only the last wave, when the search stops,
+// can hold rollouts the search does not use.
+// Rollout lengths vary widely (a collision can end one at once): a wave of one per thread keeps
+// threads waiting on the longest. 8 per thread balanced best (docs/performance.md), running
+// about 5 % more rollouts than waves of one.
+constexpr int kWavePerThread = 8;
+
 PlanResult plan(const PlanningContext& context, SimulatorWorkspace& ws,
-                const PlanningProblem& problem);
+                const PlanningProblem& problem, RolloutPool* pool = nullptr);
 
 }  // namespace lazyboe
