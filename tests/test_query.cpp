@@ -794,6 +794,21 @@ TEST(Query, BadSimThreadsAreRefusedWithOneLine) {
   }
 }
 
+// More threads than cores works, with a warning saying why it is slow.
+TEST(Query, MoreSimThreadsThanCoresWarns) {
+  const Fixture& f = fixture();
+  const std::string one =
+      write_temp_file("simthreads/warn.jsonl", query("q", f.a, f.b, "boe", 1, true).dump() + "\n");
+  const int threads = 4 * static_cast<int>(std::thread::hardware_concurrency()) + 4;
+  const ToolRun t =
+      query_tool({"--bundle", f.path, "--queries", one, "--sim-threads", std::to_string(threads)});
+  ASSERT_EQ(t.r.exit_code, 0) << describe(t.r);
+  EXPECT_TRUE(contains(t.r.err, "warning: --jobs 1 x --sim-threads " + std::to_string(threads)))
+      << describe(t.r);
+  ASSERT_EQ(t.results.size(), 1u) << describe(t.r);
+  expect_solved(t.results[0], "many sim threads");
+}
+
 // Through the library: the pool does run rollouts, and the search uses them exactly as its own.
 TEST(Query, ARolloutPoolChangesNothingButWhoSimulates) {
   const Fixture& f = fixture();
