@@ -342,7 +342,7 @@ RobotModel mixed_chain() {
 // dynamics_terms and forward_dynamics_from_terms against independent reference paths: M from
 // the link Jacobians, gravity and the velocity terms from recursive Newton-Euler, and ddq from
 // Eigen's Cholesky solve of those. For the Panda and for a chain with general axes and
-// prismatic joints, including a first joint that is prismatic.
+// prismatic joints, including a first joint that is prismatic, and a five-joint chain.
 TEST(Dynamics, DynamicsTermsMatchReferencePaths) {
   RobotModel prismatic_first = mixed_chain();
   prismatic_first.joints[0].type = JointType::Prismatic;
@@ -350,8 +350,12 @@ TEST(Dynamics, DynamicsTermsMatchReferencePaths) {
   prismatic_first.joints[0].axis_is_z = false;
   prismatic_first.q_min[0] = prismatic_first.joints[0].lower = -0.3;
   prismatic_first.q_max[0] = prismatic_first.joints[0].upper = 0.3;
+  RobotModel five_joints = mixed_chain();  // a chain of another length than seven
+  five_joints.dof = 5;
+  five_joints.joints.resize(5);
+  five_joints.bodies.resize(5);
   std::mt19937_64 rng(20);
-  for (const RobotModel& robot : {test::panda(), mixed_chain(), prismatic_first}) {
+  for (const RobotModel& robot : {test::panda(), mixed_chain(), prismatic_first, five_joints}) {
     RobotData terms(robot), reference(robot);
     const int n = robot.dof;
     for (int trial = 0; trial < 200; ++trial) {
@@ -418,34 +422,6 @@ TEST(Dynamics, SharedTermsDoNotAllocate) {
     forward_dynamics_from_terms(data, tau);
   }
   EXPECT_EQ(test::allocations.load() - before, 0);
-}
-
-// A five-joint chain (the mixed chain without its last two joints): the shared terms of the
-// simulator tick for a chain other than the seven joints above, against the reference paths.
-TEST(Dynamics, FiveJointChainMatchesReferencePaths) {
-  RobotModel robot = mixed_chain();
-  robot.dof = 5;
-  robot.joints.resize(5);
-  robot.bodies.resize(5);
-  RobotData terms(robot), reference(robot);
-  std::mt19937_64 rng(25);
-  for (int trial = 0; trial < 200; ++trial) {
-    const State s = random_state(robot, rng);
-    JointVector tau(5);
-    for (int i = 0; i < 5; ++i)
-      tau[i] = std::uniform_real_distribution<double>(-1, 1)(rng) * robot.tau_max[i];
-    const JointMatrix M = mass_matrix_from_jacobians(robot, s.q);
-    const JointVector g = gravity_torques(robot, reference, s.q);
-    const JointVector h = rnea(robot, reference, s.q, s.dq, JointVector::Zero(5), false, true);
-    const JointVector expected = Eigen::MatrixXd(M).llt().solve(tau - g - h);
-
-    dynamics_terms(robot, terms, s.q, s.dq);
-    EXPECT_LT((terms.M - M).norm(), 1e-10 * M.norm()) << "trial " << trial;
-    EXPECT_LT((terms.gravity - g).norm(), 1e-10 * std::max(1.0, g.norm())) << "trial " << trial;
-    EXPECT_LT((terms.h - h).norm(), 1e-10 * std::max(1.0, h.norm())) << "trial " << trial;
-    const JointVector ddq = forward_dynamics_from_terms(terms, tau);
-    EXPECT_LT((ddq - expected).norm(), 1e-10 * std::max(1.0, expected.norm())) << "trial " << trial;
-  }
 }
 
 }  // namespace

@@ -108,8 +108,8 @@ int main(int argc, char** argv) {
     }
     std::ostream& out = to_stdout ? std::cout : file_out;
 
-    if (sim_threads == 0) sim_threads = std::max(1, omp_get_num_procs() / jobs);
     const int cores = omp_get_num_procs();
+    if (sim_threads == 0) sim_threads = std::max(1, cores / jobs);
     if (!quiet && sim_threads > 1 && static_cast<long>(jobs) * sim_threads > cores) {
       std::fprintf(stderr,
                    "lazyboe-query: warning: --jobs %d x --sim-threads %d is more threads than the "
