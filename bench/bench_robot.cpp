@@ -12,14 +12,14 @@
 #include <string>
 #include <vector>
 
-#include "bundle/builder.h"
-#include "collision/collision_model.h"
-#include "collision/environment.h"
-#include "robot/dynamics.h"
-#include "robot/kinematics.h"
-#include "robot/robot_model.h"
-#include "sim/rollout_pool.h"
-#include "sim/simulator.h"
+#include "lazyboe/bundle/builder.h"
+#include "lazyboe/collision/collision_model.h"
+#include "lazyboe/collision/environment.h"
+#include "lazyboe/robot/dynamics.h"
+#include "lazyboe/robot/kinematics.h"
+#include "lazyboe/robot/robot_model.h"
+#include "lazyboe/sim/rollout_pool.h"
+#include "lazyboe/sim/simulator.h"
 
 namespace {
 

@@ -19,10 +19,10 @@
 #include <sstream>
 #include <thread>
 
-#include "bench/report.h"
 #include "cli_util.h"
-#include "common/error.h"
-#include "planning/ompl_planners.h"
+#include "lazyboe/bench/report.h"
+#include "lazyboe/common/error.h"
+#include "lazyboe/planning/ompl_planners.h"
 
 namespace lazyboe::test {
 namespace {

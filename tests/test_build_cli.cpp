@@ -27,9 +27,9 @@
 #include <utility>
 #include <vector>
 
-#include "bundle/bundle.h"
-#include "bundle/bundle_file.h"
 #include "cli_util.h"
+#include "lazyboe/bundle/bundle.h"
+#include "lazyboe/bundle/bundle_file.h"
 #include "test_util.h"
 
 extern char** environ;
@@ -63,7 +63,6 @@ CommandResult build_tool_in(const std::string& dir, const std::vector<std::strin
                             double timeout_seconds = 60) {
   return run("cd " + quote(dir) + " && " + build_command(args, timeout_seconds));
 }
-
 
 std::string env_file(const std::string& name) { return source_path("data/environments/" + name); }
 

@@ -13,10 +13,10 @@
 #include <random>
 #include <thread>
 
-#include "bundle/bundle_file.h"
-#include "bundle/hdf5_handle.h"
-#include "common/error.h"
-#include "common/hash.h"
+#include "lazyboe/bundle/bundle_file.h"
+#include "lazyboe/bundle/hdf5_handle.h"
+#include "lazyboe/common/error.h"
+#include "lazyboe/common/hash.h"
 #include "test_util.h"
 
 namespace lazyboe {

@@ -15,11 +15,11 @@
 #include <string>
 #include <vector>
 
-#include "collision/collision_model.h"
-#include "collision/environment.h"
-#include "io/csv.h"
-#include "robot/dynamics.h"
-#include "robot/kinematics.h"
+#include "lazyboe/collision/collision_model.h"
+#include "lazyboe/collision/environment.h"
+#include "lazyboe/io/csv.h"
+#include "lazyboe/robot/dynamics.h"
+#include "lazyboe/robot/kinematics.h"
 #include "test_util.h"
 
 namespace lazyboe::test {

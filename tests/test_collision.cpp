@@ -5,9 +5,9 @@
 
 #include <random>
 
-#include "collision/allowed_pairs.h"
-#include "collision/collision_model.h"
-#include "common/error.h"
+#include "lazyboe/collision/allowed_pairs.h"
+#include "lazyboe/collision/collision_model.h"
+#include "lazyboe/common/error.h"
 #include "test_util.h"
 
 namespace lazyboe {

@@ -11,7 +11,7 @@
 #include <random>
 
 #include "alloc_counter.h"
-#include "robot/dynamics.h"
+#include "lazyboe/robot/dynamics.h"
 #include "test_util.h"
 
 namespace lazyboe {

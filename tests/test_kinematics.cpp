@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "robot/kinematics.h"
-#include "robot/sincos.h"
+#include "lazyboe/robot/kinematics.h"
+#include "lazyboe/robot/sincos.h"
 #include "test_util.h"
 
 namespace lazyboe {

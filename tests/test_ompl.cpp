@@ -11,10 +11,10 @@
 #include <thread>
 #include <vector>
 
-#include "common/error.h"
-#include "planning/ompl_planners.h"
-#include "planning/planners.h"
-#include "planning/problem.h"
+#include "lazyboe/common/error.h"
+#include "lazyboe/planning/ompl_planners.h"
+#include "lazyboe/planning/planners.h"
+#include "lazyboe/planning/problem.h"
 #include "test_util.h"
 
 namespace lazyboe::test {

@@ -38,9 +38,9 @@
 #include <utility>
 #include <vector>
 
-#include "bundle/bundle.h"
-#include "bundle/bundle_file.h"
 #include "cli_util.h"
+#include "lazyboe/bundle/bundle.h"
+#include "lazyboe/bundle/bundle_file.h"
 #include "test_util.h"
 
 extern char** environ;
@@ -78,7 +78,6 @@ CommandResult perturb_tool_in(const std::string& dir, const std::vector<std::str
 CommandResult build_tool(const std::vector<std::string>& args, double timeout_seconds = 120) {
   return run(tool_command("lazyboe-build", args, timeout_seconds));
 }
-
 
 std::string env_file(const std::string& name) { return source_path("data/environments/" + name); }
 

@@ -5,9 +5,9 @@
 
 #include <cmath>
 
-#include "bundle/builder.h"
-#include "bundle/perturbation.h"
-#include "common/error.h"
+#include "lazyboe/bundle/builder.h"
+#include "lazyboe/bundle/perturbation.h"
+#include "lazyboe/common/error.h"
 #include "test_util.h"
 
 namespace lazyboe {

@@ -28,16 +28,16 @@
 #include <thread>
 #include <vector>
 
-#include "bundle/bundle.h"
-#include "bundle/bundle_file.h"
-#include "bundle/bundle_view.h"
-#include "collision/environment.h"
-#include "common/error.h"
-#include "io/csv.h"
-#include "planning/neighbour_index.h"
-#include "planning/planners.h"
-#include "planning/problem.h"
-#include "sim/simulator.h"
+#include "lazyboe/bundle/bundle.h"
+#include "lazyboe/bundle/bundle_file.h"
+#include "lazyboe/bundle/bundle_view.h"
+#include "lazyboe/collision/environment.h"
+#include "lazyboe/common/error.h"
+#include "lazyboe/io/csv.h"
+#include "lazyboe/planning/neighbour_index.h"
+#include "lazyboe/planning/planners.h"
+#include "lazyboe/planning/problem.h"
+#include "lazyboe/sim/simulator.h"
 #include "test_util.h"
 
 namespace lazyboe::test {

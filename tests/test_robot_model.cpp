@@ -2,8 +2,8 @@
 // joints, fixed links, side branches, a chosen tip) from URDFs written here.
 #include <gtest/gtest.h>
 
-#include "common/error.h"
-#include "robot/robot_model.h"
+#include "lazyboe/common/error.h"
+#include "lazyboe/robot/robot_model.h"
 #include "test_util.h"
 
 namespace lazyboe {

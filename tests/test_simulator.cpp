@@ -8,10 +8,10 @@
 #include <new>
 
 #include "alloc_counter.h"
-#include "bundle/builder.h"
-#include "common/error.h"
-#include "sim/rollout_pool.h"
-#include "sim/simulator.h"
+#include "lazyboe/bundle/builder.h"
+#include "lazyboe/common/error.h"
+#include "lazyboe/sim/rollout_pool.h"
+#include "lazyboe/sim/simulator.h"
 #include "test_util.h"
 
 namespace lazyboe {

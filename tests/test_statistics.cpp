@@ -8,7 +8,7 @@
 #include <cmath>
 #include <vector>
 
-#include "common/statistics.h"
+#include "lazyboe/common/statistics.h"
 
 namespace lazyboe {
 namespace {

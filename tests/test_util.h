@@ -3,9 +3,9 @@
 
 #include <string>
 
-#include "collision/collision_model.h"
-#include "robot/robot_model.h"
-#include "sim/simulator.h"
+#include "lazyboe/collision/collision_model.h"
+#include "lazyboe/robot/robot_model.h"
+#include "lazyboe/sim/simulator.h"
 
 namespace lazyboe::test {
 

@@ -11,9 +11,9 @@
 #include <map>
 #include <thread>
 
-#include "bench/report.h"
-#include "planning/ompl_planners.h"
-#include "planning/planning_session.h"
+#include "lazyboe/bench/report.h"
+#include "lazyboe/planning/ompl_planners.h"
+#include "lazyboe/planning/planning_session.h"
 #include "tool_main.h"
 
 namespace {

@@ -6,10 +6,11 @@
 #include <filesystem>
 #include <sstream>
 
-#include "bundle/builder.h"
-#include "bundle/bundle_file.h"
-#include "bundle/inspect.h"
-#include "common/json_fields.h"
+#include "lazyboe/bundle/builder.h"
+#include "lazyboe/bundle/bundle_file.h"
+#include "lazyboe/bundle/inspect.h"
+#include "lazyboe/common/json_fields.h"
+#include "lazyboe/common/version.h"
 #include "tool_main.h"
 
 namespace {
@@ -218,7 +219,7 @@ int main(int argc, char** argv) {
       }
       existing.header.target_edges = s.edges;
       existing.header.complete = false;
-      existing.header.tool_version = LAZYBOE_VERSION;
+      existing.header.tool_version = version();
       if (existing.perturbation.present) {
         // New edges have no perturbation counts: the analysis has to be run again.
         existing.perturbation = Perturbation{};

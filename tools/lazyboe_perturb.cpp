@@ -3,10 +3,10 @@
 // the counts behind them) are written into the same bundle file.
 #include <cstdio>
 
-#include "bundle/builder.h"
-#include "bundle/bundle_file.h"
-#include "bundle/inspect.h"
-#include "bundle/perturbation.h"
+#include "lazyboe/bundle/builder.h"
+#include "lazyboe/bundle/bundle_file.h"
+#include "lazyboe/bundle/inspect.h"
+#include "lazyboe/bundle/perturbation.h"
 #include "tool_main.h"
 
 namespace {

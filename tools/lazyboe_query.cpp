@@ -11,10 +11,10 @@
 #include <map>
 #include <memory>
 
-#include "common/histogram.h"
-#include "io/query_io.h"
-#include "planning/planners.h"
-#include "planning/planning_session.h"
+#include "lazyboe/common/histogram.h"
+#include "lazyboe/io/query_io.h"
+#include "lazyboe/planning/planners.h"
+#include "lazyboe/planning/planning_session.h"
 #include "tool_main.h"
 
 namespace {

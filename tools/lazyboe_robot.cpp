@@ -6,10 +6,10 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "collision/allowed_pairs.h"
-#include "collision/collision_model.h"
-#include "io/csv.h"
-#include "robot/dynamics.h"
+#include "lazyboe/collision/allowed_pairs.h"
+#include "lazyboe/collision/collision_model.h"
+#include "lazyboe/io/csv.h"
+#include "lazyboe/robot/dynamics.h"
 #include "tool_main.h"
 
 namespace {

@@ -13,7 +13,7 @@
 #include <exception>
 #include <string>
 
-#include "common/error.h"
+#include "lazyboe/common/error.h"
 
 namespace lazyboe {
 

@@ -1,10 +1,10 @@
-#include "bench/problems.h"
+#include "lazyboe/bench/problems.h"
 
 #include <cstdio>
 #include <fstream>
 
-#include "common/error.h"
-#include "sim/random.h"
+#include "lazyboe/common/error.h"
+#include "lazyboe/sim/random.h"
 
 namespace lazyboe {
 namespace {

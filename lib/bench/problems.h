@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "io/query_io.h"
+#include "lazyboe/io/query_io.h"
 
 namespace lazyboe {
 

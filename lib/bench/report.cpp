@@ -1,4 +1,4 @@
-#include "bench/report.h"
+#include "lazyboe/bench/report.h"
 
 #include <algorithm>
 #include <charconv>
@@ -9,9 +9,9 @@
 #include <map>
 #include <sstream>
 
-#include "common/error.h"
-#include "common/histogram.h"
-#include "common/statistics.h"
+#include "lazyboe/common/error.h"
+#include "lazyboe/common/histogram.h"
+#include "lazyboe/common/statistics.h"
 
 namespace lazyboe {
 namespace {

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "bench/study.h"
+#include "lazyboe/bench/study.h"
 
 namespace lazyboe {
 

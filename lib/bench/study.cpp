@@ -1,13 +1,13 @@
-#include "bench/study.h"
+#include "lazyboe/bench/study.h"
 
 #include <omp.h>
 
 #include <optional>
 #include <sstream>
 
-#include "common/error.h"
-#include "planning/ompl_planners.h"
-#include "planning/planners.h"
+#include "lazyboe/common/error.h"
+#include "lazyboe/planning/ompl_planners.h"
+#include "lazyboe/planning/planners.h"
 
 namespace lazyboe {
 

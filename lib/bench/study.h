@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "bench/problems.h"
+#include "lazyboe/bench/problems.h"
 
 namespace lazyboe {
 

@@ -1,4 +1,4 @@
-#include "bundle/builder.h"
+#include "lazyboe/bundle/builder.h"
 
 #include <omp.h>
 
@@ -8,10 +8,11 @@
 #include <cstdio>
 #include <sstream>
 
-#include "common/checkpoint.h"
-#include "common/error.h"
-#include "common/hash.h"
-#include "common/progress.h"
+#include "lazyboe/common/checkpoint.h"
+#include "lazyboe/common/error.h"
+#include "lazyboe/common/hash.h"
+#include "lazyboe/common/progress.h"
+#include "lazyboe/common/version.h"
 
 namespace lazyboe {
 
@@ -92,7 +93,7 @@ void generate_edge(const Simulator& sim, SimulatorWorkspace& ws, const BuildSett
 Bundle new_bundle(const RobotModel& robot, const Environment& env, const BuildSettings& s) {
   Bundle b;
   BundleHeader& h = b.header;
-  h.tool_version = LAZYBOE_VERSION;
+  h.tool_version = version();
   h.robot_name = robot.name;
   h.robot_config = robot.config_path;
   h.robot_hash = robot_identity(robot);

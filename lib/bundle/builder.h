@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
-#include "bundle/bundle.h"
-#include "sim/simulator.h"
+#include "lazyboe/bundle/bundle.h"
+#include "lazyboe/sim/simulator.h"
 
 namespace lazyboe {
 

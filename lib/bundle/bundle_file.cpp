@@ -1,4 +1,4 @@
-#include "bundle/bundle_file.h"
+#include "lazyboe/bundle/bundle_file.h"
 
 #include <fcntl.h>
 #include <unistd.h>
@@ -8,8 +8,8 @@
 #include <cstring>
 #include <filesystem>
 
-#include "bundle/hdf5_handle.h"
-#include "common/error.h"
+#include "lazyboe/bundle/hdf5_handle.h"
+#include "lazyboe/common/error.h"
 
 namespace lazyboe {
 namespace {

@@ -11,7 +11,7 @@
 #include <cstdint>
 #include <string>
 
-#include "bundle/bundle.h"
+#include "lazyboe/bundle/bundle.h"
 
 namespace lazyboe {
 

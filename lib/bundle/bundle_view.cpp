@@ -1,4 +1,4 @@
-#include "bundle/bundle_view.h"
+#include "lazyboe/bundle/bundle_view.h"
 
 #include <fcntl.h>
 #include <sys/mman.h>
@@ -8,9 +8,9 @@
 #include <cerrno>
 #include <cstring>
 
-#include "bundle/bundle_file.h"
-#include "bundle/hdf5_handle.h"
-#include "common/error.h"
+#include "lazyboe/bundle/bundle_file.h"
+#include "lazyboe/bundle/hdf5_handle.h"
+#include "lazyboe/common/error.h"
 
 namespace lazyboe {
 

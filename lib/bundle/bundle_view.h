@@ -10,8 +10,8 @@
 #include <string>
 #include <vector>
 
-#include "bundle/bundle.h"
-#include "sim/command_profile.h"
+#include "lazyboe/bundle/bundle.h"
+#include "lazyboe/sim/command_profile.h"
 
 namespace lazyboe {
 

@@ -1,4 +1,4 @@
-#include "bundle/hdf5_handle.h"
+#include "lazyboe/bundle/hdf5_handle.h"
 
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -9,7 +9,7 @@
 #include <limits>
 #include <type_traits>
 
-#include "common/error.h"
+#include "lazyboe/common/error.h"
 
 namespace lazyboe::h5 {
 namespace {

@@ -1,11 +1,11 @@
-#include "bundle/inspect.h"
+#include "lazyboe/bundle/inspect.h"
 
 #include <algorithm>
 #include <cmath>
 
-#include "bundle/bundle_file.h"
-#include "common/histogram.h"
-#include "sim/random.h"
+#include "lazyboe/bundle/bundle_file.h"
+#include "lazyboe/common/histogram.h"
+#include "lazyboe/sim/random.h"
 
 namespace lazyboe {
 

@@ -5,7 +5,7 @@
 #include <cstdio>
 #include <string>
 
-#include "bundle/bundle.h"
+#include "lazyboe/bundle/bundle.h"
 
 namespace lazyboe {
 

@@ -1,4 +1,4 @@
-#include "bundle/perturbation.h"
+#include "lazyboe/bundle/perturbation.h"
 
 #include <omp.h>
 
@@ -8,10 +8,10 @@
 #include <cstdio>
 #include <limits>
 
-#include "common/checkpoint.h"
-#include "common/error.h"
-#include "common/progress.h"
-#include "sim/random.h"
+#include "lazyboe/common/checkpoint.h"
+#include "lazyboe/common/error.h"
+#include "lazyboe/common/progress.h"
+#include "lazyboe/sim/random.h"
 
 namespace lazyboe {
 namespace {

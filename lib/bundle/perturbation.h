@@ -11,8 +11,8 @@
 
 #include <functional>
 
-#include "bundle/bundle.h"
-#include "sim/simulator.h"
+#include "lazyboe/bundle/bundle.h"
+#include "lazyboe/sim/simulator.h"
 
 namespace lazyboe {
 

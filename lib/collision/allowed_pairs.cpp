@@ -1,9 +1,9 @@
-#include "collision/allowed_pairs.h"
+#include "lazyboe/collision/allowed_pairs.h"
 
 #include <map>
 #include <random>
 
-#include "collision/collision_model.h"
+#include "lazyboe/collision/collision_model.h"
 
 namespace lazyboe {
 

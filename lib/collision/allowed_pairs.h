@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "robot/robot_model.h"
+#include "lazyboe/robot/robot_model.h"
 
 namespace lazyboe {
 

@@ -1,4 +1,4 @@
-#include "collision/collision_model.h"
+#include "lazyboe/collision/collision_model.h"
 
 #include <fcl/narrowphase/detail/convexity_based_algorithm/gjk.h>
 #include <fcl/narrowphase/detail/convexity_based_algorithm/minkowski_diff.h>
@@ -7,7 +7,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "common/error.h"
+#include "lazyboe/common/error.h"
 
 namespace lazyboe {
 namespace {

@@ -14,8 +14,8 @@
 #include <string>
 #include <vector>
 
-#include "collision/environment.h"
-#include "robot/kinematics.h"
+#include "lazyboe/collision/environment.h"
+#include "lazyboe/robot/kinematics.h"
 
 namespace lazyboe {
 

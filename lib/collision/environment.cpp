@@ -1,8 +1,8 @@
-#include "collision/environment.h"
+#include "lazyboe/collision/environment.h"
 
 #include <set>
 
-#include "common/json_fields.h"
+#include "lazyboe/common/json_fields.h"
 
 namespace lazyboe {
 

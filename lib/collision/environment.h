@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "robot/robot_model.h"
+#include "lazyboe/robot/robot_model.h"
 
 namespace lazyboe {
 

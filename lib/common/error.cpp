@@ -1,4 +1,4 @@
-#include "common/error.h"
+#include "lazyboe/common/error.h"
 
 namespace lazyboe {
 

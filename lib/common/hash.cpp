@@ -1,10 +1,10 @@
-#include "common/hash.h"
+#include "lazyboe/common/hash.h"
 
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
 
-#include "common/error.h"
+#include "lazyboe/common/error.h"
 
 namespace lazyboe {
 namespace {

@@ -1,4 +1,4 @@
-#include "common/histogram.h"
+#include "lazyboe/common/histogram.h"
 
 #include <algorithm>
 #include <cstdio>

@@ -1,10 +1,10 @@
-#include "common/json_fields.h"
+#include "lazyboe/common/json_fields.h"
 
 #include <cmath>
 #include <fstream>
 #include <sstream>
 
-#include "common/error.h"
+#include "lazyboe/common/error.h"
 
 namespace lazyboe {
 

@@ -1,4 +1,4 @@
-#include "common/progress.h"
+#include "lazyboe/common/progress.h"
 
 #include <unistd.h>
 

@@ -1,4 +1,4 @@
-#include "common/statistics.h"
+#include "lazyboe/common/statistics.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "io/csv.h"
+#include "lazyboe/io/csv.h"
 
 #include <unistd.h>
 
@@ -10,7 +10,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "common/error.h"
+#include "lazyboe/common/error.h"
 
 namespace lazyboe {
 namespace {

@@ -1,11 +1,11 @@
-#include "io/query_io.h"
+#include "lazyboe/io/query_io.h"
 
 #include <cmath>
 
-#include "common/error.h"
-#include "common/json_fields.h"
-#include "io/csv.h"
-#include "planning/ompl_planners.h"
+#include "lazyboe/common/error.h"
+#include "lazyboe/common/json_fields.h"
+#include "lazyboe/io/csv.h"
+#include "lazyboe/planning/ompl_planners.h"
 
 namespace lazyboe {
 namespace {

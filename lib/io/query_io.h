@@ -5,8 +5,8 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "bundle/bundle_view.h"
-#include "planning/problem.h"
+#include "lazyboe/bundle/bundle_view.h"
+#include "lazyboe/planning/problem.h"
 
 namespace lazyboe {
 

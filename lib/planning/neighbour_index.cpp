@@ -1,4 +1,4 @@
-#include "planning/neighbour_index.h"
+#include "lazyboe/planning/neighbour_index.h"
 
 #include <algorithm>
 #include <nanoflann.hpp>

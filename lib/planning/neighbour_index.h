@@ -5,7 +5,7 @@
 #include <utility>
 #include <vector>
 
-#include "bundle/bundle_view.h"
+#include "lazyboe/bundle/bundle_view.h"
 
 namespace lazyboe {
 

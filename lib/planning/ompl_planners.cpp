@@ -1,6 +1,6 @@
-#include "planning/ompl_planners.h"
+#include "lazyboe/planning/ompl_planners.h"
 
-#include "common/error.h"
+#include "lazyboe/common/error.h"
 
 #ifdef LAZYBOE_HAVE_OMPL
 #include <ompl/base/Goal.h>
@@ -33,7 +33,7 @@
 #include <mutex>
 #include <vector>
 
-#include "sim/random.h"
+#include "lazyboe/sim/random.h"
 #endif
 
 namespace lazyboe {

@@ -34,7 +34,7 @@
 #include <cstdint>
 #include <string>
 
-#include "planning/problem.h"
+#include "lazyboe/planning/problem.h"
 
 namespace lazyboe {
 

@@ -1,4 +1,4 @@
-#include "planning/planners.h"
+#include "lazyboe/planning/planners.h"
 
 #include <algorithm>
 #include <cmath>
@@ -6,9 +6,9 @@
 #include <queue>
 #include <unordered_set>
 
-#include "common/error.h"
-#include "planning/ompl_planners.h"
-#include "sim/random.h"
+#include "lazyboe/common/error.h"
+#include "lazyboe/planning/ompl_planners.h"
+#include "lazyboe/sim/random.h"
 
 namespace lazyboe {
 namespace {

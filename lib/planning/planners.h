@@ -11,8 +11,8 @@
 // Choices where the papers leave room are in docs/algorithms.md.
 #pragma once
 
-#include "planning/problem.h"
-#include "sim/rollout_pool.h"
+#include "lazyboe/planning/problem.h"
+#include "lazyboe/sim/rollout_pool.h"
 
 namespace lazyboe {
 

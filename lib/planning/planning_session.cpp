@@ -1,4 +1,4 @@
-#include "planning/planning_session.h"
+#include "lazyboe/planning/planning_session.h"
 
 #include <chrono>
 #include <fstream>

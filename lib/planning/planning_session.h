@@ -8,11 +8,11 @@
 #include <chrono>
 #include <string>
 
-#include "bundle/builder.h"
-#include "bundle/bundle_view.h"
-#include "collision/collision_model.h"
-#include "planning/neighbour_index.h"
-#include "planning/problem.h"
+#include "lazyboe/bundle/builder.h"
+#include "lazyboe/bundle/bundle_view.h"
+#include "lazyboe/collision/collision_model.h"
+#include "lazyboe/planning/neighbour_index.h"
+#include "lazyboe/planning/problem.h"
 
 namespace lazyboe {
 

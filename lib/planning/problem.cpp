@@ -1,6 +1,6 @@
-#include "planning/problem.h"
+#include "lazyboe/planning/problem.h"
 
-#include "common/error.h"
+#include "lazyboe/common/error.h"
 
 namespace lazyboe {
 

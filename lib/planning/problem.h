@@ -10,9 +10,9 @@
 #include <string>
 #include <vector>
 
-#include "bundle/bundle_view.h"
-#include "planning/neighbour_index.h"
-#include "sim/simulator.h"
+#include "lazyboe/bundle/bundle_view.h"
+#include "lazyboe/planning/neighbour_index.h"
+#include "lazyboe/sim/simulator.h"
 
 namespace lazyboe {
 

@@ -1,4 +1,4 @@
-#include "robot/dynamics.h"
+#include "lazyboe/robot/dynamics.h"
 
 #include <cmath>
 #include <type_traits>

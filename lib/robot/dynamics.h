@@ -3,7 +3,7 @@
 // returned by reference; nothing allocates.
 #pragma once
 
-#include "robot/kinematics.h"
+#include "lazyboe/robot/kinematics.h"
 
 namespace lazyboe {
 

@@ -1,8 +1,8 @@
-#include "robot/kinematics.h"
+#include "lazyboe/robot/kinematics.h"
 
 #include <cmath>
 
-#include "robot/sincos.h"
+#include "lazyboe/robot/sincos.h"
 
 namespace lazyboe {
 

@@ -3,7 +3,7 @@
 
 #include <vector>
 
-#include "robot/robot_model.h"
+#include "lazyboe/robot/robot_model.h"
 
 namespace lazyboe {
 

@@ -1,4 +1,4 @@
-#include "robot/robot_model.h"
+#include "lazyboe/robot/robot_model.h"
 
 #include <console_bridge/console.h>
 #include <tinyxml.h>
@@ -16,10 +16,10 @@
 #include <set>
 #include <sstream>
 
-#include "common/error.h"
-#include "common/json_fields.h"
-#include "robot/dynamics.h"
-#include "robot/kinematics.h"
+#include "lazyboe/common/error.h"
+#include "lazyboe/common/json_fields.h"
+#include "lazyboe/robot/dynamics.h"
+#include "lazyboe/robot/kinematics.h"
 
 namespace lazyboe {
 namespace {

@@ -7,7 +7,7 @@
 #include <utility>
 #include <vector>
 
-#include "robot/types.h"
+#include "lazyboe/robot/types.h"
 
 namespace lazyboe {
 

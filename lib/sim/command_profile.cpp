@@ -1,4 +1,4 @@
-#include "sim/command_profile.h"
+#include "lazyboe/sim/command_profile.h"
 
 #include <algorithm>
 #include <cmath>

@@ -9,8 +9,8 @@
 
 #include <vector>
 
-#include "robot/robot_model.h"
-#include "sim/random.h"
+#include "lazyboe/robot/robot_model.h"
+#include "lazyboe/sim/random.h"
 
 namespace lazyboe {
 

@@ -1,9 +1,9 @@
-#include "sim/rollout_pool.h"
+#include "lazyboe/sim/rollout_pool.h"
 
 #include <chrono>
 #include <string>
 
-#include "common/error.h"
+#include "lazyboe/common/error.h"
 
 namespace lazyboe {
 namespace {

@@ -16,7 +16,7 @@
 #include <thread>
 #include <vector>
 
-#include "sim/simulator.h"
+#include "lazyboe/sim/simulator.h"
 
 namespace lazyboe {
 

@@ -1,9 +1,9 @@
-#include "sim/simulator.h"
+#include "lazyboe/sim/simulator.h"
 
 #include <algorithm>
 #include <cmath>
 
-#include "common/error.h"
+#include "lazyboe/common/error.h"
 
 namespace lazyboe {
 

@@ -12,9 +12,9 @@
 #include <cstdint>
 #include <vector>
 
-#include "collision/collision_model.h"
-#include "robot/dynamics.h"
-#include "sim/command_profile.h"
+#include "lazyboe/collision/collision_model.h"
+#include "lazyboe/robot/dynamics.h"
+#include "lazyboe/sim/command_profile.h"
 
 namespace lazyboe {
 
