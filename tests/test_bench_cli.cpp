@@ -22,7 +22,7 @@
 #include "cli_util.h"
 #include "lazyboe/bench/report.h"
 #include "lazyboe/common/error.h"
-#include "lazyboe/planning/ompl_planners.h"
+#include "lazyboe/planning/ompl/ompl_planners.h"
 
 namespace lazyboe::test {
 namespace {

@@ -1,7 +1,7 @@
 // OMPL's control planners (ompl-rrt, ompl-sst, ompl-kpiece) on our problem: each solves an easy
 // joint goal in the empty environment, its path passes realize_path (re-simulated, re-validated,
 // ends in the goal) at the reported cost, and its counters are filled; RRT and KPIECE1 are
-// repeatable for a seed (per query, also from two threads at once); plan() and the query
+// repeatable for a seed (per query, also from two threads at once); the registry and the query
 // reader route the names; a build without OMPL refuses them with a clear error.
 // Budgets are small: the whole binary takes a few seconds.
 #include <gtest/gtest.h>
@@ -12,9 +12,9 @@
 #include <vector>
 
 #include "lazyboe/common/error.h"
-#include "lazyboe/planning/ompl_planners.h"
-#include "lazyboe/planning/planners.h"
+#include "lazyboe/planning/ompl/ompl_planners.h"
 #include "lazyboe/planning/problem.h"
+#include "lazyboe/planning/registry.h"
 #include "test_util.h"
 
 namespace lazyboe::test {
@@ -27,19 +27,21 @@ JointVector joints(std::initializer_list<double> v) {
   return q;
 }
 
+struct Query {
+  std::string planner;
+  PlanningProblem problem;
+};
+
 // Start at the centre of a small box, goal 0.39 rad away, tolerance 0.3.
-PlanningProblem easy_problem(const std::string& planner, double budget, uint64_t seed = 1) {
+Query easy_problem(const std::string& planner, double budget, uint64_t seed = 1) {
   PlanningProblem p;
   p.start = joints({0.0, 0.25, 0.0, -2.0, 0.0, 1.9, 0.8});
   p.goal.kind = Goal::Kind::Joint;
   p.goal.q = p.start + joints({0.2, -0.15, 0.15, 0.15, -0.15, 0.1, 0.1});
   p.goal.tolerance = 0.3;
-  p.params.planner = planner;
-  p.params.budget = budget;
-  p.params.seed = seed;
-  p.params.sample_lower = joints({-0.3, 0.0, -0.3, -2.3, -0.3, 1.6, 0.5});
-  p.params.sample_upper = joints({0.3, 0.5, 0.3, -1.7, 0.3, 2.2, 1.1});
-  return p;
+  p.termination.budget = budget;
+  p.seed = seed;
+  return {planner, p};
 }
 
 const Scene& scene() {
@@ -47,16 +49,24 @@ const Scene& scene() {
   return s;
 }
 
-PlanResult run(const PlanningProblem& p) {
+// The sampling box of the problems above.
+PlanningContext context() {
+  PlanningContext ctx{scene().sim};
+  ctx.sample_lower = joints({-0.3, 0.0, -0.3, -2.3, -0.3, 1.6, 0.5});
+  ctx.sample_upper = joints({0.3, 0.5, 0.3, -1.7, 0.3, 2.2, 1.1});
+  return ctx;
+}
+
+PlanResult run(const Query& q) {
   SimulatorWorkspace ws(scene().sim);
-  const PlanningContext ctx{scene().sim};
-  return plan(ctx, ws, p);
+  return plan(context(), ws, q.planner, {}, q.problem);
 }
 
 void expect_solved(const std::string& planner, double budget) {
   if (!ompl_available()) GTEST_SKIP() << "built without OMPL";
-  const PlanningProblem p = easy_problem(planner, budget);
-  const PlanResult r = run(p);
+  const Query q = easy_problem(planner, budget);
+  const PlanningProblem& p = q.problem;
+  const PlanResult r = run(q);
   ASSERT_TRUE(r.success) << planner << ": " << r.failure;
   EXPECT_GE(r.n_solutions, 1);
   EXPECT_TRUE(std::isfinite(r.time_to_first_solution));
@@ -81,11 +91,13 @@ void expect_solved(const std::string& planner, double budget) {
 }
 
 TEST(Ompl, Names) {
-  EXPECT_TRUE(is_ompl_planner("ompl-rrt"));
-  EXPECT_TRUE(is_ompl_planner("ompl-sst"));
-  EXPECT_TRUE(is_ompl_planner("ompl-kpiece"));
-  EXPECT_FALSE(is_ompl_planner("rrt"));
-  EXPECT_FALSE(is_ompl_planner("ompl-prm"));
+  for (const char* name : {"ompl-rrt", "ompl-sst", "ompl-kpiece"}) {
+    ASSERT_NE(find_planner(name), nullptr) << name;
+    EXPECT_TRUE(find_planner(name)->needs.ompl) << name;
+    EXPECT_EQ(find_planner(name)->available(), ompl_available()) << name;
+  }
+  EXPECT_FALSE(find_planner("rrt")->needs.ompl);
+  EXPECT_EQ(find_planner("ompl-prm"), nullptr);
   EXPECT_THROW(run(easy_problem("ompl-prm", 1)), Error);
 }
 
@@ -95,10 +107,10 @@ TEST(Ompl, KpieceSolvesEasyProblem) { expect_solved("ompl-kpiece", 3); }
 
 TEST(Ompl, SstStopsAtFirstWhenAsked) {
   if (!ompl_available()) GTEST_SKIP() << "built without OMPL";
-  PlanningProblem p = easy_problem("ompl-sst", 5);
-  p.params.stop_at_first = true;
+  Query q = easy_problem("ompl-sst", 5);
+  q.problem.termination.stop_at_first = true;
   const auto t0 = std::chrono::steady_clock::now();
-  const PlanResult r = run(p);
+  const PlanResult r = run(q);
   const double took = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   ASSERT_TRUE(r.success) << r.failure;
   EXPECT_EQ(r.n_solutions, 1);

@@ -12,7 +12,7 @@
 #include <thread>
 
 #include "lazyboe/bench/report.h"
-#include "lazyboe/planning/ompl_planners.h"
+#include "lazyboe/planning/ompl/ompl_planners.h"
 #include "lazyboe/planning/planning_session.h"
 #include "tool_main.h"
 
@@ -168,14 +168,13 @@ int main(int argc, char** argv) {
       }
     }
 
-    planner_specs(planners, PlannerParams{});  // names checked before the bundle is loaded
+    planner_specs(planners);  // names checked before the bundle is loaded
     const PlanningSession session(bundle_path, !no_mmap, robot_path, env_path);
     if (!quiet) {
       std::fprintf(stderr, "lazyboe-bench: %s: %zu edges loaded in %.3f s\n", bundle_path.c_str(),
                    session.bundle.size(), session.load_seconds);
     }
-    const PlannerParams defaults = session.default_params();
-    const std::vector<PlannerSpec> specs = planner_specs(planners, defaults);
+    const std::vector<PlannerSpec> specs = planner_specs(planners);
     for (const PlannerSpec& s : specs) {
       if (!s.available)
         std::fprintf(stderr, "lazyboe-bench: skipping %s: %s\n", s.name.c_str(),
@@ -188,8 +187,6 @@ int main(int argc, char** argv) {
     std::vector<BenchProblem> study_problems;
     std::string problems_source;
     QueryDefaults query_defaults;
-    query_defaults.params = defaults;
-    query_defaults.theta = defaults.theta;
     if (resume) {
       study_problems = read_problems(problems_path.string(), session.sim, ws, query_defaults);
       problems_source = "resumed from " + problems_path.string();
@@ -202,6 +199,7 @@ int main(int argc, char** argv) {
         study_problems = read_problems(problems_file, session.sim, ws, query_defaults);
         problems_source = "read from " + problems_file;
       } else {
+        const PlanningContext defaults = session.context();
         const double radius = tolerance > 0 ? tolerance : defaults.theta;
         study_problems = sample_problems(session.sim, ws, defaults.sample_lower,
                                          defaults.sample_upper, problems, radius, seed);

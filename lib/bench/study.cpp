@@ -6,22 +6,60 @@
 #include <sstream>
 
 #include "lazyboe/common/error.h"
-#include "lazyboe/planning/ompl_planners.h"
-#include "lazyboe/planning/planners.h"
+#include "lazyboe/planning/registry.h"
 
 namespace lazyboe {
 
-std::vector<PlannerSpec> planner_specs(const std::string& list, const PlannerParams& defaults) {
-  static const std::vector<std::string> all = {"lazyboe",  "boe",      "rrt",
-                                               "sst-0.5x", "sst-1x",   "sst-2x",
-                                               "ompl-rrt", "ompl-sst", "ompl-kpiece"};
+namespace {
+
+// The names a study runs for a planner: its variants, or itself.
+std::vector<std::string> study_names(const PlannerInfo& info) {
+  if (info.study_variants.empty()) return {info.name};
+  std::vector<std::string> names;
+  for (const PlannerVariant& v : info.study_variants) names.push_back(v.name);
+  return names;
+}
+
+std::string study_names_text() {
+  std::vector<std::string> names = {"all"};
+  for (const PlannerInfo& info : planner_registry()) {
+    names.push_back(info.name);
+    for (const PlannerVariant& v : info.study_variants) names.push_back(v.name);
+  }
+  std::string text;
+  for (size_t k = 0; k < names.size(); ++k)
+    text += (k == 0 ? "" : k + 1 == names.size() ? " or " : ", ") + names[k];
+  return text;
+}
+
+PlannerSpec spec_named(const std::string& name) {
+  for (const PlannerInfo& info : planner_registry()) {
+    PlannerSpec s;
+    s.planner = info.name;
+    s.available = info.available(&s.unavailable_reason);
+    s.name = name;
+    if (info.study_variants.empty() && info.name == name) return s;
+    for (const PlannerVariant& v : info.study_variants) {
+      if (v.name != name) continue;
+      s.parameters = v.values;
+      return s;
+    }
+  }
+  fail("--planners", "unknown planner '" + name + "' (expected " + study_names_text() + ")");
+}
+
+}  // namespace
+
+std::vector<PlannerSpec> planner_specs(const std::string& list) {
   std::vector<std::string> names;
   std::stringstream in(list);
   for (std::string name; std::getline(in, name, ',');) {
+    const PlannerInfo* info = find_planner(name);
     if (name == "all") {
-      names.insert(names.end(), all.begin(), all.end());
-    } else if (name == "sst") {
-      names.insert(names.end(), {"sst-0.5x", "sst-1x", "sst-2x"});
+      for (const PlannerInfo& i : planner_registry())
+        for (const std::string& n : study_names(i)) names.push_back(n);
+    } else if (info) {
+      for (const std::string& n : study_names(*info)) names.push_back(n);
     } else {
       names.push_back(name);
     }
@@ -29,29 +67,10 @@ std::vector<PlannerSpec> planner_specs(const std::string& list, const PlannerPar
   if (names.empty()) fail("--planners", "no planner named");
   std::vector<PlannerSpec> specs;
   for (const std::string& name : names) {
-    PlannerSpec s;
-    s.name = name;
-    s.params = defaults;
-    if (name == "lazyboe" || name == "boe" || name == "rrt") {
-      s.params.planner = name;
-    } else if (name == "sst-0.5x" || name == "sst-1x" || name == "sst-2x") {
-      s.params.planner = "sst";
-      s.params.pruning_ratio = name == "sst-0.5x" ? 0.5 : name == "sst-1x" ? 1.0 : 2.0;
-    } else if (is_ompl_planner(name)) {
-      s.params.planner = name;
-      if (!ompl_available()) {
-        s.available = false;
-        s.unavailable_reason = "built without OMPL (install libompl-dev and rebuild)";
-      }
-    } else {
-      fail("--planners", "unknown planner '" + name +
-                             "' (expected all, lazyboe, boe, rrt, sst, sst-0.5x, sst-1x, sst-2x, "
-                             "ompl-rrt, ompl-sst or ompl-kpiece)");
-    }
     for (const PlannerSpec& other : specs) {
       if (other.name == name) fail("--planners", "'" + name + "' named twice");
     }
-    specs.push_back(std::move(s));
+    specs.push_back(spec_named(name));
   }
   return specs;
 }
@@ -70,11 +89,13 @@ RunRecord run_planner(const PlanningContext& context, SimulatorWorkspace& ws,
   r.repeat = repeat;
   r.seed = seed;
   r.budget = budget;
-  PlanningProblem p{problem.start, problem.goal, planner.params};
-  p.params.seed = seed;
-  p.params.budget = budget;
+  PlanningProblem p;
+  p.start = problem.start;
+  p.goal = problem.goal;
+  p.termination.budget = budget;
+  p.seed = seed;
   try {
-    const PlanResult result = plan(context, ws, p);
+    const PlanResult result = plan(context, ws, planner.planner, planner.parameters, p);
     r.counters = result.counters;
     r.n_solutions = result.n_solutions;
     if (!result.success) {

@@ -8,21 +8,24 @@
 #include <vector>
 
 #include "lazyboe/bench/problems.h"
+#include "lazyboe/planning/parameters.h"
 
 namespace lazyboe {
 
 struct PlannerSpec {
-  std::string name;      // as in runs.csv: lazyboe, boe, rrt, sst-0.5x, ..., ompl-sst
-  PlannerParams params;  // planner (as plan() knows it) and its parameters
+  std::string name;            // as in runs.csv: lazyboe, boe, rrt, sst-0.5x, ..., ompl-sst
+  std::string planner;         // its name in the planner registry
+  ParameterValues parameters;  // a study variant's values (e.g. sst-2x: pruning_ratio 2)
   bool available = true;
   std::string unavailable_reason;
 };
 
-// The study's planners: "all" or a comma-separated list of lazyboe, boe, rrt, sst-0.5x, sst-1x,
-// sst-2x (the paper's pruning-to-selection ratios; "sst" means all three), ompl-rrt, ompl-sst,
-// ompl-kpiece. OMPL planners in a build without OMPL are kept, marked unavailable. Throws
-// Error("--planners", ...) for an unknown name.
-std::vector<PlannerSpec> planner_specs(const std::string& list, const PlannerParams& defaults);
+// The study's planners, from the planner registry: "all" (every registered planner, or its
+// study variants where it has them: SST's sst-0.5x, sst-1x, sst-2x, the paper's pruning-to-
+// selection ratios) or a comma-separated list of names, where a planner with variants means
+// all of them ("sst"). Planners not built in (OMPL's without OMPL) are kept, marked
+// unavailable. Throws Error("--planners", ...) for an unknown name or one named twice.
+std::vector<PlannerSpec> planner_specs(const std::string& list);
 
 struct RunRecord {
   std::string planner;

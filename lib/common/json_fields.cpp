@@ -60,10 +60,14 @@ std::vector<JsonField> JsonField::items() const {
 }
 
 void JsonField::allow_only(std::initializer_list<const char*> keys) const {
+  allow_only(std::vector<std::string>(keys.begin(), keys.end()));
+}
+
+void JsonField::allow_only(const std::vector<std::string>& keys) const {
   if (!value_->is_object()) fail("expected an object");
   for (auto it = value_->begin(); it != value_->end(); ++it) {
     bool known = false;
-    for (const char* k : keys) known = known || it.key() == k;
+    for (const std::string& k : keys) known = known || it.key() == k;
     if (!known) {
       lazyboe::fail(file_ + ": " + (path_.empty() ? "" : path_ + ".") + it.key(), "unknown field");
     }

@@ -26,6 +26,7 @@ class JsonField {
   std::vector<JsonField> items() const;        // elements of an array
   // Rejects members other than these, so a misspelt optional field is not silently ignored.
   void allow_only(std::initializer_list<const char*> keys) const;
+  void allow_only(const std::vector<std::string>& keys) const;
 
   double number() const;  // finite
   double number_at_least(double min) const;

@@ -5,7 +5,6 @@
 #include "lazyboe/common/error.h"
 #include "lazyboe/common/json_fields.h"
 #include "lazyboe/io/csv.h"
-#include "lazyboe/planning/ompl_planners.h"
 
 namespace lazyboe {
 namespace {
@@ -17,12 +16,65 @@ JointVector joint_vector(const JsonField& f, int dof) {
   return Eigen::Map<const Eigen::VectorXd>(v.data(), dof);
 }
 
-void check_state_usable(const JsonField& f, const JointVector& q, const Simulator& sim,
-                        SimulatorWorkspace& ws) {
-  const RolloutStatus s = check_state(sim, ws, q);
-  if (s == RolloutStatus::PositionLimit) f.fail("outside the joint limits");
-  if (s == RolloutStatus::SelfCollision) f.fail("in self-collision");
-  if (s == RolloutStatus::EnvCollision) f.fail("in collision with the environment");
+const ParameterSpec& any_declaration(const std::string& name) {
+  for (const PlannerInfo& info : planner_registry())
+    if (const ParameterSpec* spec = info.parameter(name)) return *spec;
+  fail(name, "no planner declares this parameter");
+}
+
+// The planner and the values of its declared parameters.
+void parse_planner(const JsonField& root, Query& q) {
+  q.planner = root.has("planner") ? root.at("planner").string() : "lazyboe";
+  if (!find_planner(q.planner)) {
+    root.at("planner").fail("unknown planner '" + q.planner + "' (expected " +
+                            planner_names_text() + ")");
+  }
+  const PlannerInfo& info = *find_planner(q.planner);
+  for (const std::string& name : all_parameter_names()) {
+    if (!root.has(name)) continue;
+    const JsonField f = root.at(name);
+    // Another planner's parameter is checked by that planner's declaration, and ignored.
+    const ParameterSpec* spec = info.parameter(name);
+    const ParameterSpec& declared = spec ? *spec : any_declaration(name);
+    const double v = declared.type == ParameterType::Boolean   ? (f.boolean() ? 1.0 : 0.0)
+                     : declared.type == ParameterType::Integer ? static_cast<double>(f.integer())
+                                                               : f.number();
+    const std::string why = declared.check(v);
+    if (!why.empty()) f.fail(why);
+    if (spec) q.parameters.set(name, v);
+  }
+}
+
+void parse_position_goal(const JsonField& goal, const RobotModel& robot, const QueryDefaults& d,
+                         Goal& g) {
+  goal.allow_only({"position", "tolerance", "link"});
+  g.kind = Goal::Kind::Position;
+  g.position = goal.at("position").vec3();
+  g.tolerance = goal.has("tolerance") ? goal.at("tolerance").positive() : d.position_tolerance;
+  const std::string link =
+      goal.has("link") ? goal.at("link").string() : robot.links[robot.tip_link()].name;
+  g.link = robot.link_index(link);
+  if (g.link < 0) goal.at("link").fail("unknown link '" + link + "'");
+}
+
+void parse_goal(const JsonField& goal, const RobotModel& robot, const QueryDefaults& d, Goal& g) {
+  if (goal.has("q")) {
+    goal.allow_only({"q", "tolerance"});
+    g.kind = Goal::Kind::Joint;
+    g.q = joint_vector(goal.at("q"), robot.dof);
+    g.tolerance = goal.has("tolerance") ? goal.at("tolerance").positive() : d.joint_tolerance;
+  } else if (goal.has("position")) {
+    parse_position_goal(goal, robot, d, g);
+  } else {
+    goal.fail("expected \"q\" (joint goal) or \"position\" (end-effector goal)");
+  }
+}
+
+std::vector<std::string> query_fields() {
+  std::vector<std::string> fields = {"id",     "start", "goal",         "planner",
+                                     "budget", "seed",  "stop_at_first"};
+  for (const std::string& name : all_parameter_names()) fields.push_back(name);
+  return fields;
 }
 
 }  // namespace
@@ -39,65 +91,20 @@ Query parse_query(const std::string& text, int line, const RobotModel& robot, co
   if (!doc.is_object()) fail(where, "expected a JSON object");
   if (doc.contains("id") && doc["id"].is_string()) id_out = doc["id"].get<std::string>();
   const JsonField root(doc, where, "");
-  root.allow_only({"id", "start", "goal", "planner", "budget", "seed", "theta", "stop_at_first",
-                   "goal_bias", "selection_radius", "pruning_ratio"});
+  root.allow_only(query_fields());
   Query q;
   q.line = line;
   q.id = root.at("id").string();
-  PlannerParams& p = q.problem.params;
-  p = d.params;
-  p.planner = root.has("planner") ? root.at("planner").string() : "lazyboe";
-  if (p.planner != "lazyboe" && p.planner != "boe" && p.planner != "rrt" && p.planner != "sst" &&
-      !is_ompl_planner(p.planner)) {
-    root.at("planner").fail(
-        "unknown planner '" + p.planner +
-        "' (expected lazyboe, boe, rrt, sst, ompl-rrt, ompl-sst or ompl-kpiece)");
-  }
-  p.budget = root.has("budget") ? root.at("budget").positive() : d.budget;
+  parse_planner(root, q);
+  PlanningProblem& p = q.problem;
+  p.termination.budget = root.has("budget") ? root.at("budget").positive() : d.budget;
+  if (root.has("stop_at_first")) p.termination.stop_at_first = root.at("stop_at_first").boolean();
   p.seed = root.has("seed") ? static_cast<uint64_t>(root.at("seed").integer()) : 1;
   if (root.has("seed") && root.at("seed").integer() < 0) root.at("seed").fail("must be >= 0");
-  p.theta = root.has("theta") ? root.at("theta").positive() : d.theta;
-  if (root.has("stop_at_first")) p.stop_at_first = root.at("stop_at_first").boolean();
-  if (root.has("goal_bias")) {
-    p.goal_bias = root.at("goal_bias").number_at_least(0);
-    if (p.goal_bias > 1) root.at("goal_bias").fail("must be in [0, 1]");
-  }
-  if (root.has("selection_radius")) p.selection_radius = root.at("selection_radius").positive();
-  if (root.has("pruning_ratio")) p.pruning_ratio = root.at("pruning_ratio").positive();
-
-  q.problem.start = joint_vector(root.at("start"), robot.dof);
-  check_state_usable(root.at("start"), q.problem.start, sim, ws);
-
-  const JsonField goal = root.at("goal");
-  Goal& g = q.problem.goal;
-  if (goal.has("q")) {
-    goal.allow_only({"q", "tolerance"});
-    g.kind = Goal::Kind::Joint;
-    g.q = joint_vector(goal.at("q"), robot.dof);
-    g.tolerance = goal.has("tolerance") ? goal.at("tolerance").positive() : d.joint_tolerance;
-    check_state_usable(goal.at("q"), g.q, sim, ws);
-  } else if (goal.has("position")) {
-    goal.allow_only({"position", "tolerance", "link"});
-    g.kind = Goal::Kind::Position;
-    g.position = goal.at("position").vec3();
-    g.tolerance = goal.has("tolerance") ? goal.at("tolerance").positive() : d.position_tolerance;
-    const std::string link =
-        goal.has("link") ? goal.at("link").string() : robot.links[robot.tip_link()].name;
-    g.link = robot.link_index(link);
-    if (g.link < 0) goal.at("link").fail("unknown link '" + link + "'");
-    // Reach bound: the sum of joint offsets from the first joint on.
-    double reach = 0;
-    for (const Joint& j : robot.joints) reach += j.origin.p.norm();
-    reach += robot.links[g.link].in_body.p.norm();
-    const Eigen::Vector3d shoulder = robot.joints[0].origin.p;
-    if ((g.position - shoulder).norm() > reach + g.tolerance) {
-      goal.at("position").fail("unreachable: farther than the arm can reach");
-    }
-  } else {
-    goal.fail("expected \"q\" (joint goal) or \"position\" (end-effector goal)");
-  }
-  RobotData data(robot);
-  if (g.contains(robot, data, q.problem.start)) goal.fail("the start already satisfies the goal");
+  p.start = joint_vector(root.at("start"), robot.dof);
+  parse_goal(root.at("goal"), robot, d, p.goal);
+  const ProblemIssue issue = find_problem_issue(sim, ws, p);
+  if (issue.any()) fail(where + ": " + issue.field, issue.what);
   return q;
 }
 
@@ -106,7 +113,7 @@ nlohmann::json result_json(const Query& q, const PlanResult& r, const Trajectory
   nlohmann::json j;
   j["id"] = q.id;
   j["line"] = q.line;
-  j["planner"] = q.problem.params.planner;
+  j["planner"] = q.planner;
   j["success"] = r.success;
   j["time_to_first_solution"] =
       r.success ? nlohmann::json(r.time_to_first_solution) : nlohmann::json(nullptr);

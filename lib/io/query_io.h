@@ -7,26 +7,30 @@
 
 #include "lazyboe/bundle/bundle_view.h"
 #include "lazyboe/planning/problem.h"
+#include "lazyboe/planning/registry.h"
 
 namespace lazyboe {
 
 struct Query {
   std::string id;
   int line = 0;
+  std::string planner = "lazyboe";  // a name in the planner registry
+  ParameterValues parameters;       // the planner's declared parameters the query sets
   PlanningProblem problem;
 };
 
-// Defaults for fields a query leaves out (from the bundle, when there is one).
+// Defaults for fields a query leaves out. (Planner parameters it leaves out take the planner's
+// defaults, theta the bundle's.)
 struct QueryDefaults {
-  double theta = 0.35;
   double budget = 5.0;
   double joint_tolerance = 0.1;
   double position_tolerance = 0.02;
-  PlannerParams params;  // sampling box and command family for RRT/SST
 };
 
-// Parses and checks one line (the id first, so even a bad query can be answered by id).
-// Throws Error("line N: field: what") for anything malformed, out of limits or in collision.
+// Parses one line (the id first, so even a bad query can be answered by id) and validates its
+// problem (validate_problem's checks). A query may set any parameter a registered planner
+// declares; those its planner does not declare are ignored. Throws Error("line N: field:
+// what") for anything malformed, out of range, out of limits or in collision.
 Query parse_query(const std::string& text, int line, const RobotModel& robot, const Simulator& sim,
                   SimulatorWorkspace& ws, const QueryDefaults& defaults, std::string& id_out);
 

@@ -30,13 +30,13 @@ double PlanningSession::default_theta() const {
   return bundle.has_perturbation() ? bundle.perturbation_theta() : bundle.header().design_theta;
 }
 
-PlannerParams PlanningSession::default_params() const {
-  PlannerParams p;
-  p.theta = default_theta();
-  p.sample_lower = settings.region_lower;
-  p.sample_upper = settings.region_upper;
-  p.command = settings.command;
-  return p;
+PlanningContext PlanningSession::context() const {
+  PlanningContext c{sim, &bundle, &index};
+  c.theta = default_theta();
+  c.sample_lower = settings.region_lower;
+  c.sample_upper = settings.region_upper;
+  c.command = settings.command;
+  return c;
 }
 
 double resident_memory_mib() {

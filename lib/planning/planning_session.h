@@ -12,7 +12,7 @@
 #include "lazyboe/bundle/bundle_view.h"
 #include "lazyboe/collision/collision_model.h"
 #include "lazyboe/planning/neighbour_index.h"
-#include "lazyboe/planning/problem.h"
+#include "lazyboe/planning/planner.h"
 
 namespace lazyboe {
 
@@ -37,12 +37,11 @@ class PlanningSession {
   const EdgeStartIndex index;
   const double load_seconds;  // wall time of everything above
 
-  PlanningContext context() const { return {sim, &bundle, &index}; }
+  // The planning context: the simulator, the bundle and its index, and from the bundle the
+  // default theta (default_theta), the sampling box and the command family.
+  PlanningContext context() const;
   // theta of the perturbation analysis, or the bundle's design theta without one.
   double default_theta() const;
-  // Planner parameters that come from the bundle: theta, the sampling box and command family
-  // of RRT/SST.
-  PlannerParams default_params() const;
 };
 
 // Resident memory of this process (VmRSS), MiB; 0 where /proc is not available.

@@ -10,6 +10,60 @@ double Goal::distance(const RobotModel& robot, RobotData& data, const JointVecto
   return (link_pose(robot, data, link).p - position).norm();
 }
 
+namespace {
+
+ProblemIssue state_issue(const Simulator& sim, SimulatorWorkspace& ws, const std::string& field,
+                         const JointVector& q) {
+  const int n = sim.robot.dof;
+  if (q.size() != n) return {field, "expected " + std::to_string(n) + " joint values"};
+  switch (check_state(sim, ws, q)) {
+    case RolloutStatus::PositionLimit:
+      return {field, "outside the joint limits"};
+    case RolloutStatus::SelfCollision:
+      return {field, "in self-collision"};
+    case RolloutStatus::EnvCollision:
+      return {field, "in collision with the environment"};
+    default:
+      return {};
+  }
+}
+
+// A position farther from the shoulder than the sum of the joint offsets (plus the link's
+// offset in its body) cannot be reached.
+bool out_of_reach(const RobotModel& robot, const Goal& g) {
+  double reach = 0;
+  for (const Joint& j : robot.joints) reach += j.origin.p.norm();
+  reach += robot.links[g.link].in_body.p.norm();
+  const Eigen::Vector3d shoulder = robot.joints[0].origin.p;
+  return (g.position - shoulder).norm() > reach + g.tolerance;
+}
+
+}  // namespace
+
+ProblemIssue find_problem_issue(const Simulator& sim, SimulatorWorkspace& ws,
+                                const PlanningProblem& p) {
+  const RobotModel& robot = sim.robot;
+  if (ProblemIssue i = state_issue(sim, ws, "start", p.start); i.any()) return i;
+  const Goal& g = p.goal;
+  if (g.kind == Goal::Kind::Joint) {
+    if (ProblemIssue i = state_issue(sim, ws, "goal.q", g.q); i.any()) return i;
+  } else {
+    if (g.link < 0 || g.link >= static_cast<int>(robot.links.size()))
+      return {"goal.link", "no link " + std::to_string(g.link)};
+    if (out_of_reach(robot, g))
+      return {"goal.position", "unreachable: farther than the arm can reach"};
+  }
+  if (!(g.tolerance > 0)) return {"goal.tolerance", "must be > 0"};
+  if (g.contains(robot, ws.robot, p.start)) return {"goal", "the start already satisfies the goal"};
+  if (!(p.termination.budget > 0)) return {"budget", "must be > 0"};
+  return {};
+}
+
+void validate_problem(const Simulator& sim, SimulatorWorkspace& ws, const PlanningProblem& p) {
+  const ProblemIssue issue = find_problem_issue(sim, ws, p);
+  if (issue.any()) fail(issue.field, issue.what);
+}
+
 Trajectory realize_path(const Simulator& sim, SimulatorWorkspace& ws, const JointVectorRef& start,
                         const std::vector<PathStep>& steps, const Goal& goal, int sample_every) {
   const int n = sim.robot.dof;

@@ -1,5 +1,5 @@
-// What every planner shares: the planning problem (start, goal region, budget), the planning
-// context (one simulator, the bundle and its neighbour index), results and paths. A returned
+// What every planner shares: the planning problem (start, goal region, termination, seed), its
+// validation, results and paths. A returned
 // path is a sequence of commands; its trajectory comes from simulating them again from the
 // exact start, with every check (realize_path).
 #pragma once
@@ -10,8 +10,6 @@
 #include <string>
 #include <vector>
 
-#include "lazyboe/bundle/bundle_view.h"
-#include "lazyboe/planning/neighbour_index.h"
 #include "lazyboe/sim/simulator.h"
 
 namespace lazyboe {
@@ -31,26 +29,36 @@ struct Goal {
   }
 };
 
-struct PlannerParams {
-  std::string planner = "lazyboe";  // lazyboe, boe, rrt, sst
-  double theta = 0;                 // neighbourhood radius (bundle planners), rad
-  double budget = 5.0;              // wall-clock seconds
-  uint64_t seed = 1;
-  bool stop_at_first = false;  // RRT always stops at its first solution
-  // RRT and SST
-  double goal_bias = 0.05;
-  // SST: selection radius delta_BN and pruning radius delta_s = pruning_ratio * delta_BN
-  double selection_radius = 0.2;
-  double pruning_ratio = 1.0;
-  JointVector sample_lower, sample_upper;  // state sampling box (default: the bundle's region)
-  CommandSampling command;                 // control family of RRT/SST (default: the bundle's)
+// When a solve stops: its wall-clock budget has run out or, with stop_at_first, it has found a
+// solution. (RRT, OMPL's RRT and KPIECE always stop at their first solution.)
+struct Termination {
+  double budget = 5.0;  // wall-clock seconds, from the start of the solve
+  bool stop_at_first = false;
 };
 
+// One planning problem: from `start` (at rest) into the goal region, until `termination`, with
+// the planner's random draws seeded by `seed`.
 struct PlanningProblem {
   JointVector start;
   Goal goal;
-  PlannerParams params;
+  Termination termination;
+  uint64_t seed = 1;
 };
+
+// What is wrong with a problem: the field at fault ("start", "goal.q", "goal.position",
+// "goal") and why. Empty field: nothing.
+struct ProblemIssue {
+  std::string field, what;
+  bool any() const { return !field.empty(); }
+};
+
+// Every check a problem gets before any planner sees it: joint counts, the start and a joint
+// goal inside the limits and collision-free, a position goal's link and reach, a positive
+// tolerance, and a start not already in the goal.
+ProblemIssue find_problem_issue(const Simulator& sim, SimulatorWorkspace& ws,
+                                const PlanningProblem& problem);
+// The same, throwing Error("<field>: <what>") for the first issue found.
+void validate_problem(const Simulator& sim, SimulatorWorkspace& ws, const PlanningProblem& problem);
 
 // One step of a path: a command applied from the previous step's end state.
 struct PathStep {
@@ -82,13 +90,6 @@ struct Trajectory {
   std::vector<int64_t> edges;  // bundle edge of each step (-1 for RRT/SST commands)
   double cost = 0;             // joint-space arc length, rad
   double duration = 0;
-};
-
-// Shared, read-only planning context.
-struct PlanningContext {
-  const Simulator& sim;
-  const BundleView* bundle = nullptr;  // null for planners that do not use one
-  const EdgeStartIndex* index = nullptr;
 };
 
 // Simulates `steps` from `start` with every check and returns the trajectory (samples every

@@ -1,6 +1,8 @@
-#include "lazyboe/planning/ompl_planners.h"
+#include "lazyboe/planning/ompl/ompl_planners.h"
 
 #include "lazyboe/common/error.h"
+#include "lazyboe/planning/planners/sst.h"
+#include "lazyboe/planning/planners/tree_search.h"
 
 #ifdef LAZYBOE_HAVE_OMPL
 #include <ompl/base/Goal.h>
@@ -38,8 +40,65 @@
 
 namespace lazyboe {
 
-bool is_ompl_planner(const std::string& name) {
-  return name == "ompl-rrt" || name == "ompl-sst" || name == "ompl-kpiece";
+namespace {
+
+// Runs OMPL planner `name` on one problem (defined below; without OMPL it only refuses).
+PlanResult plan_ompl(const PlanningContext& ctx, SimulatorWorkspace& ws,
+                     const PlanningProblem& problem, const std::string& name,
+                     const ParameterValues& values);
+
+class OmplPlanner : public Planner {
+ public:
+  OmplPlanner(const ParameterValues& values, std::string name)
+      : values_(values), name_(std::move(name)) {}
+
+  void setup(const PlanningContext& context) override {
+    if (!ompl_available()) {
+      fail("planner", "'" + name_ +
+                          "' is not available: lazyboe was built without OMPL (install "
+                          "libompl-dev and rebuild)");
+    }
+    check_sampling_box(context, name_);
+    context_ = &context;
+  }
+
+  PlanResult solve(const PlanningProblem& problem, SimulatorWorkspace& ws, RolloutPool*) override {
+    if (!context_) fail(name_, "solve before setup");
+    return plan_ompl(*context_, ws, problem, name_, values_);
+  }
+
+ private:
+  ParameterValues values_;
+  std::string name_;
+  const PlanningContext* context_ = nullptr;
+};
+
+PlannerInfo ompl_info(const std::string& name, const std::string& description,
+                      std::vector<ParameterSpec> parameters) {
+  PlannerInfo info;
+  info.name = name;
+  info.description = description;
+  info.needs.ompl = true;
+  info.parameters = std::move(parameters);
+  info.make = [name](const ParameterValues& v) { return std::make_unique<OmplPlanner>(v, name); };
+  return info;
+}
+
+}  // namespace
+
+PlannerInfo ompl_rrt_planner_info() {
+  return ompl_info("ompl-rrt", "OMPL's control RRT on our simulator, checks and goal",
+                   {goal_bias_parameter()});
+}
+
+PlannerInfo ompl_sst_planner_info() {
+  return ompl_info(
+      "ompl-sst", "OMPL's control SST on our simulator, checks and goal; anytime",
+      {goal_bias_parameter(), selection_radius_parameter(), pruning_ratio_parameter()});
+}
+
+PlannerInfo ompl_kpiece_planner_info() {
+  return ompl_info("ompl-kpiece", "OMPL's control KPIECE1 on our simulator, checks and goal", {});
 }
 
 #ifndef LAZYBOE_HAVE_OMPL
@@ -48,11 +107,14 @@ bool ompl_available() { return false; }
 
 void seed_ompl(uint64_t) {}
 
-PlanResult plan_ompl(const PlanningContext&, SimulatorWorkspace&, const PlanningProblem& problem) {
-  fail("planner", "'" + problem.params.planner +
-                      "' is not available: lazyboe was built without OMPL (install libompl-dev "
-                      "and rebuild)");
+namespace {
+
+PlanResult plan_ompl(const PlanningContext&, SimulatorWorkspace&, const PlanningProblem&,
+                     const std::string& name, const ParameterValues&) {
+  fail("planner", "'" + name + "' is not available: lazyboe was built without OMPL");
 }
+
+}  // namespace
 
 #else
 
@@ -91,18 +153,20 @@ class Search {
  public:
   Search(const PlanningContext& ctx, SimulatorWorkspace& workspace, const PlanningProblem& p)
       : sim(ctx.sim),
+        ctx(ctx),
         ws(workspace),
         problem(p),
         dof(ctx.sim.robot.dof),
-        max_knots(1 + std::max(2, static_cast<int>(std::lround(p.params.command.max_duration /
-                                                               p.params.command.knot_interval)))),
-        control_rng(p.params.seed, 2),
-        state_rng(p.params.seed, 3),
+        max_knots(1 + std::max(2, static_cast<int>(std::lround(ctx.command.max_duration /
+                                                               ctx.command.knot_interval)))),
+        control_rng(p.seed, 2),
+        state_rng(p.seed, 3),
         goal_data_(ctx.sim.robot),
         last_from_(dof),
         last_to_(dof) {}
 
   const Simulator& sim;
+  const PlanningContext& ctx;
   SimulatorWorkspace& ws;
   const PlanningProblem& problem;
   const int dof, max_knots;
@@ -193,14 +257,14 @@ class BoxSampler : public ob::StateSampler {
   BoxSampler(const ob::StateSpace* space, Search& s) : ob::StateSampler(space), s_(s) {}
 
   void sampleUniform(ob::State* state) override {
-    const PlannerParams& p = s_.problem.params;
+    const PlanningContext& c = s_.ctx;
     double* q = values(state);
     for (int i = 0; i < s_.dof; ++i)
-      q[i] = s_.state_rng.uniform(p.sample_lower[i], p.sample_upper[i]);
+      q[i] = s_.state_rng.uniform(c.sample_lower[i], c.sample_upper[i]);
   }
   // Not used by RRT, SST or KPIECE1; given for completeness.
   void sampleUniformNear(ob::State* state, const ob::State* near, double distance) override {
-    const PlannerParams& p = s_.problem.params;
+    const PlanningContext& p = s_.ctx;
     double* q = values(state);
     const double* c = values(near);
     for (int i = 0; i < s_.dof; ++i) {
@@ -226,7 +290,7 @@ class CommandSampler : public oc::ControlSampler {
   using oc::ControlSampler::sample;
   void sample(oc::Control* control) override {
     const double duration =
-        sample_command_profile(s_.sim.robot, s_.problem.params.command, s_.control_rng, s_.knots);
+        sample_command_profile(s_.sim.robot, s_.ctx.command, s_.control_rng, s_.knots);
     const int n_knots = static_cast<int>(s_.knots.size()) / s_.dof;
     if (n_knots > s_.max_knots) fail("planner", "command profile has more knots than expected");
     double* v = values(control);
@@ -308,7 +372,7 @@ class ArcLengthObjective : public ob::OptimizationObjective {
   }
   bool isSatisfied(ob::Cost c) const override {
     s_.improved(c.value());
-    return s_.problem.params.stop_at_first;
+    return s_.problem.termination.stop_at_first;
   }
 
  private:
@@ -347,147 +411,180 @@ void seed_ompl(uint64_t seed) {
   std::call_once(seed_once(), [seed] { ompl::RNG::setSeed(ompl_seed(seed, 4)); });
 }
 
-PlanResult plan_ompl(const PlanningContext& ctx, SimulatorWorkspace& ws,
-                     const PlanningProblem& problem) {
-  const std::string& name = problem.params.planner;
-  if (!is_ompl_planner(name)) fail("planner", "'" + name + "' is not an OMPL planner");
-  const PlannerParams& params = problem.params;
-  const RobotModel& robot = ctx.sim.robot;
-  const int n = robot.dof;
-  if (params.sample_lower.size() != n || params.sample_upper.size() != n) {
-    fail("planner", name + " needs a sampling box of " + std::to_string(n) + " joints");
+namespace {
+
+// States: the sampling box, widened to hold the start and a joint goal.
+std::shared_ptr<ob::RealVectorStateSpace> state_space(Search& search) {
+  const PlanningContext& ctx = search.ctx;
+  const PlanningProblem& problem = search.problem;
+  const int n = search.dof;
+  auto space = std::make_shared<ob::RealVectorStateSpace>(n);
+  ob::RealVectorBounds bounds(n);
+  for (int i = 0; i < n; ++i) {
+    double lo = std::min(ctx.sample_lower[i], problem.start[i]);
+    double hi = std::max(ctx.sample_upper[i], problem.start[i]);
+    if (problem.goal.kind == Goal::Kind::Joint) {
+      lo = std::min(lo, problem.goal.q[i]);
+      hi = std::max(hi, problem.goal.q[i]);
+    }
+    bounds.setLow(i, lo);
+    bounds.setHigh(i, hi);
   }
-  if (problem.start.size() != n) fail("start", "expected " + std::to_string(n) + " joints");
-  seed_ompl(params.seed);
+  space->setBounds(bounds);
+  space->setStateSamplerAllocator([&search](const ob::StateSpace* s) -> ob::StateSamplerPtr {
+    return std::make_shared<BoxSampler>(s, search);
+  });
+  return space;
+}
 
-  Search search(ctx, ws, problem);  // outlives every OMPL object below
-  // The clock starts here, as our planners' does at their start: OMPL's setup is part of the
-  // time to first solution and of the budget.
-  search.solve_start = Clock::now();
-  PlanResult result;
-  try {
-    // States: the sampling box, widened to hold the start and a joint goal.
-    auto space = std::make_shared<ob::RealVectorStateSpace>(n);
-    ob::RealVectorBounds bounds(n);
+// Controls: duration, knot count, knots.
+std::shared_ptr<oc::RealVectorControlSpace> control_space(
+    Search& search, const std::shared_ptr<ob::RealVectorStateSpace>& space) {
+  const CommandSampling& command = search.ctx.command;
+  const RobotModel& robot = search.sim.robot;
+  const int n = search.dof;
+  const int control_dim = kControlHeader + search.max_knots * n;
+  auto cspace = std::make_shared<oc::RealVectorControlSpace>(space, control_dim);
+  ob::RealVectorBounds cbounds(control_dim);
+  cbounds.setLow(0, command.min_duration);
+  cbounds.setHigh(0, std::max(command.max_duration, command.min_duration + 1e-9));
+  cbounds.setLow(1, 2);
+  cbounds.setHigh(1, std::max(search.max_knots, 3));
+  for (int k = 0; k < search.max_knots; ++k) {
     for (int i = 0; i < n; ++i) {
-      double lo = std::min(params.sample_lower[i], problem.start[i]);
-      double hi = std::max(params.sample_upper[i], problem.start[i]);
-      if (problem.goal.kind == Goal::Kind::Joint) {
-        lo = std::min(lo, problem.goal.q[i]);
-        hi = std::max(hi, problem.goal.q[i]);
-      }
-      bounds.setLow(i, lo);
-      bounds.setHigh(i, hi);
+      cbounds.setLow(kControlHeader + k * n + i, -robot.dq_max[i]);
+      cbounds.setHigh(kControlHeader + k * n + i, robot.dq_max[i]);
     }
-    space->setBounds(bounds);
-    space->setStateSamplerAllocator([&search](const ob::StateSpace* s) -> ob::StateSamplerPtr {
-      return std::make_shared<BoxSampler>(s, search);
-    });
+  }
+  cspace->setBounds(cbounds);
+  cspace->setControlSamplerAllocator([&search](const oc::ControlSpace* c) -> oc::ControlSamplerPtr {
+    return std::make_shared<CommandSampler>(c, search);
+  });
+  return cspace;
+}
 
-    // Controls: duration, knot count, knots.
-    const int control_dim = kControlHeader + search.max_knots * n;
-    auto cspace = std::make_shared<oc::RealVectorControlSpace>(space, control_dim);
-    ob::RealVectorBounds cbounds(control_dim);
-    cbounds.setLow(0, params.command.min_duration);
-    cbounds.setHigh(0, std::max(params.command.max_duration, params.command.min_duration + 1e-9));
-    cbounds.setLow(1, 2);
-    cbounds.setHigh(1, std::max(search.max_knots, 3));
-    for (int k = 0; k < search.max_knots; ++k) {
-      for (int i = 0; i < n; ++i) {
-        cbounds.setLow(kControlHeader + k * n + i, -robot.dq_max[i]);
-        cbounds.setHigh(kControlHeader + k * n + i, robot.dq_max[i]);
-      }
-    }
-    cspace->setBounds(cbounds);
-    cspace->setControlSamplerAllocator(
-        [&search](const oc::ControlSpace* c) -> oc::ControlSamplerPtr {
-          return std::make_shared<CommandSampler>(c, search);
-        });
+std::shared_ptr<ob::ProblemDefinition> problem_definition(
+    Search& search, const oc::SpaceInformationPtr& si,
+    const std::shared_ptr<ob::RealVectorStateSpace>& space) {
+  auto pdef = std::make_shared<ob::ProblemDefinition>(si);
+  ob::ScopedState<> start(space);
+  for (int i = 0; i < search.dof; ++i) start[i] = search.problem.start[i];
+  pdef->addStartState(start);
+  pdef->setGoal(std::make_shared<GoalRegion>(si, search));
+  pdef->setOptimizationObjective(std::make_shared<ArcLengthObjective>(si, search));
+  // Later OMPL versions also report SST's improving solutions here (counted once per cost).
+  pdef->setIntermediateSolutionCallback(
+      [&search](const ob::Planner*, const std::vector<const ob::State*>&, const ob::Cost c) {
+        search.improved(c.value());
+      });
+  return pdef;
+}
 
-    auto si = std::make_shared<oc::SpaceInformation>(space, cspace);
-    si->setStatePropagator(std::make_shared<Propagator>(si, search));
-    si->setStateValidityChecker(std::make_shared<ValidityChecker>(si, search));
-    si->setPropagationStepSize(1.0);  // one step = one whole command
-    si->setMinMaxControlDuration(1, 1);
-    si->setup();
+ob::PlannerPtr ompl_planner(const std::string& name, const ParameterValues& values,
+                            const Search& search, const oc::SpaceInformationPtr& si,
+                            const std::shared_ptr<ob::RealVectorStateSpace>& space) {
+  const std::uint_fast32_t planner_seed = ompl_seed(search.problem.seed, 5);
+  if (name == "ompl-rrt") {
+    auto rrt = std::make_shared<Seeded<oc::RRT> >(si, planner_seed);
+    rrt->setGoalBias(values.get("goal_bias"));
+    return rrt;
+  }
+  if (name == "ompl-sst") {
+    auto sst = std::make_shared<Seeded<oc::SST> >(si, planner_seed);
+    sst->setGoalBias(values.get("goal_bias"));
+    sst->setSelectionRadius(values.get("selection_radius"));
+    sst->setPruningRadius(values.get("pruning_ratio") * values.get("selection_radius"));
+    return sst;
+  }
+  auto kpiece = std::make_shared<Seeded<oc::KPIECE1> >(si, planner_seed);
+  // Projection: the first three joints (the ones that move the arm most), grid cells of a
+  // twentieth of the sampling box, as OMPL infers for its own projections. Fixed, unlike
+  // RealVectorStateSpace's default random linear projection, so a query is repeatable.
+  std::vector<unsigned int> joints;
+  std::vector<double> cells;
+  for (int i = 0; i < std::min(3, search.dof); ++i) {
+    joints.push_back(static_cast<unsigned int>(i));
+    cells.push_back((search.ctx.sample_upper[i] - search.ctx.sample_lower[i]) / 20);
+  }
+  kpiece->setProjectionEvaluator(
+      std::make_shared<ob::RealVectorOrthogonalProjectionEvaluator>(space, cells, joints));
+  return kpiece;
+}
 
-    auto pdef = std::make_shared<ob::ProblemDefinition>(si);
-    ob::ScopedState<> start(space);
-    for (int i = 0; i < n; ++i) start[i] = problem.start[i];
-    pdef->addStartState(start);
-    pdef->setGoal(std::make_shared<GoalRegion>(si, search));
-    pdef->setOptimizationObjective(std::make_shared<ArcLengthObjective>(si, search));
-    // Later OMPL versions also report SST's improving solutions here (counted once per cost).
-    pdef->setIntermediateSolutionCallback(
-        [&search](const ob::Planner*, const std::vector<const ob::State*>&, const ob::Cost c) {
-          search.improved(c.value());
-        });
+// The solution path as our commands, each re-simulated for its cost.
+void take_solution(const std::string& name, Search& search, const ob::ProblemDefinition& pdef,
+                   PlanResult& result) {
+  const auto path = std::static_pointer_cast<oc::PathControl>(pdef.getSolutionPath());
+  const int n = search.dof;
+  JointVector q = search.problem.start;
+  double cost = 0;
+  for (const oc::Control* c : path->getControls()) {
+    const CommandProfile p = search.profile(values(c));
+    result.best_path.push_back(
+        {-1, std::vector<double>(p.knots, p.knots + p.n_knots * n), p.duration});
+    // The same deterministic rollout the planner made: its arc length is the step's cost.
+    const RolloutResult r = simulate(search.sim, search.ws, q, p);
+    if (!r.valid()) fail("planner", name + " returned a command that fails simulation");
+    cost += r.path_length;
+    q = r.qf;
+  }
+  result.success = true;
+  result.best_cost = cost;
+  result.time_to_first_solution =
+      std::isnan(search.first_solution) ? search.elapsed() : search.first_solution;
+  result.n_solutions = name == "ompl-sst" ? std::max(1, search.improvements) : 1;
+}
 
-    const std::uint_fast32_t planner_seed = ompl_seed(params.seed, 5);
-    ob::PlannerPtr planner;
-    if (name == "ompl-rrt") {
-      auto rrt = std::make_shared<Seeded<oc::RRT> >(si, planner_seed);
-      rrt->setGoalBias(params.goal_bias);
-      planner = rrt;
-    } else if (name == "ompl-sst") {
-      auto sst = std::make_shared<Seeded<oc::SST> >(si, planner_seed);
-      sst->setGoalBias(params.goal_bias);
-      sst->setSelectionRadius(params.selection_radius);
-      sst->setPruningRadius(params.pruning_ratio * params.selection_radius);
-      planner = sst;
-    } else {
-      auto kpiece = std::make_shared<Seeded<oc::KPIECE1> >(si, planner_seed);
-      // Projection: the first three joints (the ones that move the arm most), grid cells of a
-      // twentieth of the sampling box, as OMPL infers for its own projections. Fixed, unlike
-      // RealVectorStateSpace's default random linear projection, so a query is repeatable.
-      std::vector<unsigned int> joints;
-      std::vector<double> cells;
-      for (int i = 0; i < std::min(3, n); ++i) {
-        joints.push_back(static_cast<unsigned int>(i));
-        cells.push_back((params.sample_upper[i] - params.sample_lower[i]) / 20);
-      }
-      kpiece->setProjectionEvaluator(
-          std::make_shared<ob::RealVectorOrthogonalProjectionEvaluator>(space, cells, joints));
-      planner = kpiece;
-    }
-    planner->setProblemDefinition(pdef);
-    planner->setup();
+PlanResult solve_with_ompl(const std::string& name, const ParameterValues& values, Search& search) {
+  auto space = state_space(search);
+  auto cspace = control_space(search, space);
+  auto si = std::make_shared<oc::SpaceInformation>(space, cspace);
+  si->setStatePropagator(std::make_shared<Propagator>(si, search));
+  si->setStateValidityChecker(std::make_shared<ValidityChecker>(si, search));
+  si->setPropagationStepSize(1.0);  // one step = one whole command
+  si->setMinMaxControlDuration(1, 1);
+  si->setup();
+  const auto pdef = problem_definition(search, si, space);
+  const ob::PlannerPtr planner = ompl_planner(name, values, search, si, space);
+  planner->setProblemDefinition(pdef);
+  planner->setup();
 
-    const ob::PlannerTerminationCondition ptc =
-        ob::timedPlannerTerminationCondition(std::max(0.0, params.budget - search.elapsed()));
-    const ob::PlannerStatus status = planner->solve(ptc);
+  const double budget = search.problem.termination.budget;
+  const ob::PlannerTerminationCondition ptc =
+      ob::timedPlannerTerminationCondition(std::max(0.0, budget - search.elapsed()));
+  const ob::PlannerStatus status = planner->solve(ptc);
 
-    result.counters = search.counters;
-    result.counters.nodes = 1 + search.tree_states;  // the start and every state added
-    if (status == ob::PlannerStatus::EXACT_SOLUTION && pdef->hasExactSolution()) {
-      const auto path = std::static_pointer_cast<oc::PathControl>(pdef->getSolutionPath());
-      JointVector q = problem.start;
-      double cost = 0;
-      for (const oc::Control* c : path->getControls()) {
-        const CommandProfile p = search.profile(values(c));
-        result.best_path.push_back(
-            {-1, std::vector<double>(p.knots, p.knots + p.n_knots * n), p.duration});
-        // The same deterministic rollout the planner made: its arc length is the step's cost.
-        const RolloutResult r = simulate(ctx.sim, ws, q, p);
-        if (!r.valid()) fail("planner", name + " returned a command that fails simulation");
-        cost += r.path_length;
-        q = r.qf;
-      }
-      result.success = true;
-      result.best_cost = cost;
-      result.time_to_first_solution =
-          std::isnan(search.first_solution) ? search.elapsed() : search.first_solution;
-      result.n_solutions = name == "ompl-sst" ? std::max(1, search.improvements) : 1;
-    } else if (status == ob::PlannerStatus::INVALID_START) {
-      result.failure = "OMPL rejected the start state (" + status.asString() + ")";
-    } else {
-      result.failure = "no solution within the time budget";
-    }
-  } catch (const ompl::Exception& e) {
-    fail("planner", name + ": OMPL: " + e.what());
+  PlanResult result;
+  result.counters = search.counters;
+  result.counters.nodes = 1 + search.tree_states;  // the start and every state added
+  if (status == ob::PlannerStatus::EXACT_SOLUTION && pdef->hasExactSolution()) {
+    take_solution(name, search, *pdef, result);
+  } else if (status == ob::PlannerStatus::INVALID_START) {
+    result.failure = "OMPL rejected the start state (" + status.asString() + ")";
+  } else {
+    result.failure = "no solution within the time budget";
   }
   return result;
 }
+
+PlanResult plan_ompl(const PlanningContext& ctx, SimulatorWorkspace& ws,
+                     const PlanningProblem& problem, const std::string& name,
+                     const ParameterValues& values) {
+  const int n = ctx.sim.robot.dof;
+  if (problem.start.size() != n) fail("start", "expected " + std::to_string(n) + " joints");
+  seed_ompl(problem.seed);
+  Search search(ctx, ws, problem);  // outlives every OMPL object of solve_with_ompl
+  // The clock starts here, as our planners' does at their start: OMPL's setup is part of the
+  // time to first solution and of the budget.
+  search.solve_start = Clock::now();
+  try {
+    return solve_with_ompl(name, values, search);
+  } catch (const ompl::Exception& e) {
+    fail("planner", name + ": OMPL: " + e.what());
+  }
+}
+
+}  // namespace
 
 #endif
 

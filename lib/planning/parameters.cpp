@@ -1,0 +1,54 @@
+#include "lazyboe/planning/parameters.h"
+
+#include <sstream>
+
+#include "lazyboe/common/error.h"
+
+namespace lazyboe {
+namespace {
+
+std::string number_text(double v) {
+  std::ostringstream o;
+  o << v;
+  return o.str();
+}
+
+}  // namespace
+
+std::string ParameterSpec::range_text() const {
+  if (type == ParameterType::Boolean) return "true or false";
+  const bool has_lower = std::isfinite(lower), has_upper = std::isfinite(upper);
+  if (has_lower && has_upper) {
+    return std::string(lower_exclusive ? "(" : "[") + number_text(lower) + ", " +
+           number_text(upper) + "]";
+  }
+  if (has_lower) return std::string(lower_exclusive ? "> " : ">= ") + number_text(lower);
+  if (has_upper) return "<= " + number_text(upper);
+  return "any";
+}
+
+std::string ParameterSpec::default_text() const {
+  if (!has_fixed_default()) return default_from;
+  if (type == ParameterType::Boolean) return default_value != 0 ? "true" : "false";
+  return number_text(default_value);
+}
+
+std::string ParameterSpec::check(double value) const {
+  if (!std::isfinite(value)) return "must be a finite number";
+  if (type == ParameterType::Boolean && value != 0 && value != 1) return "must be true or false";
+  if (type == ParameterType::Integer && value != std::floor(value)) return "must be an integer";
+  const bool below = lower_exclusive ? !(value > lower) : !(value >= lower);
+  if (below || value > upper) {
+    const bool interval = std::isfinite(lower) && std::isfinite(upper);
+    return std::string("must be ") + (interval ? "in " : "") + range_text();
+  }
+  return "";
+}
+
+double ParameterValues::get(const std::string& name) const {
+  const auto it = values_.find(name);
+  if (it == values_.end()) fail(name, "parameter not set");
+  return it->second;
+}
+
+}  // namespace lazyboe

@@ -1,0 +1,49 @@
+// The planner interface, in OMPL's spirit: a planner is made with its declared parameters
+// (registry.h), set up once per planning context, solves one problem at a time under a
+// termination condition, and is cleared. Every planner shares the context's one simulator,
+// and so its validity checks: planners differ only in their search.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "lazyboe/bundle/bundle_view.h"
+#include "lazyboe/planning/neighbour_index.h"
+#include "lazyboe/planning/problem.h"
+#include "lazyboe/sim/command_profile.h"
+#include "lazyboe/sim/rollout_pool.h"
+
+namespace lazyboe {
+
+// Shared, read-only planning context: the simulator, and for the bundle planners the bundle
+// and its neighbour index; what sampling planners need (the state sampling box and command
+// family; by default the bundle's); the default neighbourhood radius.
+struct PlanningContext {
+  const Simulator& sim;
+  const BundleView* bundle = nullptr;  // null for planners that do not use one
+  const EdgeStartIndex* index = nullptr;
+  double theta = 0;                        // the bundle's theta, rad (0: none)
+  JointVector sample_lower, sample_upper;  // state sampling box
+  CommandSampling command;                 // control family of the sampling planners
+};
+
+class Planner {
+ public:
+  virtual ~Planner() = default;
+
+  // Checks that the context has what the planner needs (a bundle, perturbation data, a
+  // sampling box) and resolves parameters whose default comes from it. Throws Error naming
+  // what is missing. The context must outlive the planner's solves.
+  virtual void setup(const PlanningContext& context) = 0;
+
+  // Plans one problem (validate_problem first: a planner assumes a valid one) until its
+  // termination condition. `ws` is the calling thread's workspace; `pool`, when given and of
+  // several threads, may run independent rollouts in parallel (the answer does not change).
+  virtual PlanResult solve(const PlanningProblem& problem, SimulatorWorkspace& ws,
+                           RolloutPool* pool = nullptr) = 0;
+
+  // Forgets everything but the setup (our planners keep no state between solves).
+  virtual void clear() {}
+};
+
+}  // namespace lazyboe

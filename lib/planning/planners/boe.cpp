@@ -1,0 +1,19 @@
+#include "lazyboe/planning/planners/boe.h"
+
+#include "lazyboe/planning/planners/bundle_search.h"
+
+namespace lazyboe {
+
+PlannerInfo boe_planner_info() {
+  PlannerInfo info;
+  info.name = "boe";
+  info.description = "Bundle of Edges: best-first search simulating every edge within theta";
+  info.needs.bundle = true;
+  info.parameters = {theta_parameter()};
+  info.make = [](const ParameterValues& v) {
+    return std::make_unique<BundlePlanner<BundleSearch>>(v, "boe", false);
+  };
+  return info;
+}
+
+}  // namespace lazyboe

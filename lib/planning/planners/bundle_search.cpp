@@ -1,0 +1,191 @@
+#include "lazyboe/planning/planners/bundle_search.h"
+
+#include <algorithm>
+#include <string>
+
+namespace lazyboe {
+namespace {
+
+JointVector row(const double* p, int n) { return Eigen::Map<const Eigen::VectorXd>(p, n); }
+
+}  // namespace
+
+ParameterSpec theta_parameter() {
+  ParameterSpec p;
+  p.name = "theta";
+  p.lower = 0;
+  p.lower_exclusive = true;
+  p.description = "neighbourhood radius in joint space, rad";
+  p.default_from = "the bundle's (its perturbation analysis's, else its design theta)";
+  return p;
+}
+
+double bundle_planner_setup(const PlanningContext& ctx, const ParameterValues& values,
+                            const std::string& planner, bool perturbation) {
+  if (!ctx.bundle || !ctx.index) fail("planner", planner + " needs an edge bundle");
+  if (perturbation && !ctx.bundle->has_perturbation()) {
+    fail(ctx.bundle->path(), "has no complete perturbation analysis, which " + planner +
+                                 " needs (run lazyboe-perturb)");
+  }
+  const double theta = values.get_or("theta", ctx.theta);
+  if (!(theta > 0)) fail("theta", "must be > 0");
+  return theta;
+}
+
+BundleSearch::BundleSearch(const PlanningContext& ctx, SimulatorWorkspace& ws,
+                           const PlanningProblem& p, double theta, RolloutPool* pool)
+    : ctx_(ctx), bundle_(*ctx.bundle), s_(ctx, ws, p), theta_(theta), ahead_(pool) {}
+
+JointVector BundleSearch::edge_end(uint32_t e) const { return row(bundle_.qf(e), bundle_.dof()); }
+JointVector BundleSearch::edge_start(uint32_t e) const { return row(bundle_.q0(e), bundle_.dof()); }
+double BundleSearch::heuristic_at_end(uint32_t e) {
+  return s_.heuristic(row(bundle_.qf(e), bundle_.dof()));
+}
+
+PlanResult BundleSearch::run() {
+  SearchNode root;
+  root.q = s_.problem().start;
+  root.h = s_.heuristic(root.q);
+  push(s_.add(root));
+  Neighbours neighbours;
+  if (!covered(neighbours)) return s_.result();
+  while (!s_.should_stop()) {
+    const int v = pop();
+    if (v < 0) break;
+    if (skip(v)) continue;
+    ctx_.index->within(s_.node(v).q.data(), radius(v), neighbours);
+    if (neighbours.empty() && defer(v)) continue;
+    expand(v, neighbours);
+  }
+  PlanResult& r = s_.result();
+  if (!r.success && r.failure.empty()) {
+    r.failure = open_.empty() ? "search exhausted: no more nodes to expand within the bundle"
+                              : "no solution within the time budget";
+  }
+  return r;
+}
+
+// Coverage: a start or goal the bundle cannot reach is a clear failure, not a timeout.
+bool BundleSearch::covered(Neighbours& neighbours) {
+  ctx_.index->within(s_.problem().start.data(), theta_, neighbours);
+  if (neighbours.empty()) {
+    s_.result().failure = "no bundle edge starts within theta = " + std::to_string(theta_) +
+                          " rad of the start: it is outside the bundle's coverage";
+    return false;
+  }
+  const Goal& goal = s_.problem().goal;
+  if (goal.kind != Goal::Kind::Joint) return true;
+  const double reach = theta_ + goal.tolerance;
+  const int n = bundle_.dof();
+  for (size_t e = 0; e < bundle_.size(); ++e) {
+    if ((row(bundle_.qf(e), n) - goal.q).squaredNorm() <= reach * reach) return true;
+  }
+  s_.result().failure = "no bundle edge ends within theta + tolerance = " + std::to_string(reach) +
+                        " rad of the goal: it is outside the bundle's coverage";
+  return false;
+}
+
+// The next node to expand, or -1 when there is none (the open list ran dry and no hook
+// refilled it).
+int BundleSearch::pop() {
+  if (open_.empty() && (!refill() || open_.empty())) return -1;
+  const int v = open_.top().second;
+  open_.pop();
+  return v;
+}
+
+bool BundleSearch::skip(int v) {
+  const SearchNode& node = s_.node(v);
+  if (node.expanded || dead(v)) return true;
+  if (s_.in_goal(node.h) && !node.lazy) return true;  // already a solution
+  return prunable(v);
+}
+
+void BundleSearch::expand(int v, Neighbours& neighbours) {
+  s_.node(v).expanded = true;
+  // Most promising edges first (heuristic at their stored end): the same edges are taken,
+  // but a goal reached in this expansion is reached sooner.
+  order_by_promise(neighbours);
+  begin_expansion(v, neighbours);
+  expanding_ = v;
+  expansion_ = &neighbours;
+  ahead_.begin(v, neighbours.size());
+  for (size_t k = 0; k < neighbours.size(); ++k) {
+    if (s_.should_stop() || dead(v)) break;
+    if (!visit(v, k, neighbours[k].first)) break;
+  }
+}
+
+void BundleSearch::order_by_promise(Neighbours& edges) {
+  for (auto& [e, key] : edges) key = heuristic_at_end(e);
+  std::stable_sort(edges.begin(), edges.end(),
+                   [](const auto& x, const auto& y) { return x.second < y.second; });
+}
+
+bool BundleSearch::dead(int v) {
+  for (int u = v; u >= 0; u = s_.node(u).parent) {
+    if (s_.node(u).failed) return true;
+    if (!s_.node(u).lazy) break;
+  }
+  return false;
+}
+
+// After a solution, a node whose cost plus the least remaining arc length (joint goals:
+// distance to the goal minus the tolerance) cannot beat the best is not expanded.
+bool BundleSearch::prunable(int v) {
+  const PlanResult& r = s_.result();
+  if (!r.success || s_.problem().goal.kind != Goal::Kind::Joint) return false;
+  const SearchNode& node = s_.node(v);
+  return node.cost + std::max(0.0, node.h - s_.problem().goal.tolerance) >= r.best_cost;
+}
+
+std::vector<PathStep> BundleSearch::path_to(int node) {
+  std::vector<PathStep> steps;
+  for (int u = node; s_.node(u).parent >= 0; u = s_.node(u).parent) {
+    const CommandProfile c = bundle_.command(s_.node(u).bundle_edge);
+    steps.push_back({s_.node(u).bundle_edge,
+                     std::vector<double>(c.knots, c.knots + c.n_knots * c.dof), c.duration});
+  }
+  std::reverse(steps.begin(), steps.end());
+  return steps;
+}
+
+void BundleSearch::found(int node) {
+  s_.solution(node, [this](int u) { return path_to(u); });
+}
+
+bool BundleSearch::needs_rollout(int v, size_t k) { return !simulated(v, expansion_edge(k)); }
+
+RolloutResult BundleSearch::rollout_from(int v, size_t k) {
+  const uint32_t e = (*expansion_)[k].first;
+  if (!ahead_.enabled() || v != expanding_)
+    return s_.simulate_from(s_.node(v).q, bundle_.command(e));
+  // v became real at neighbour k (or was real): from here on, plan which neighbours need a
+  // rollout from it.
+  if (!ahead_.planned()) ahead_.plan(k, [&](size_t j) { return needs_rollout(v, j); });
+  const RolloutResult& r = ahead_.take(
+      k, s_.node(v).q.data(), [&](size_t j) { return bundle_.command((*expansion_)[j].first); });
+  s_.count(r);
+  return r;
+}
+
+void BundleSearch::simulate_edge(int v, uint32_t e, size_t k) {
+  // The same edge from the same real node always gives the same rollout: never twice.
+  if (!simulated_.insert(key(v, e)).second) return;
+  const RolloutResult r = rollout_from(v, k);
+  if (!r.valid()) return;
+  SearchNode c;
+  c.q = r.qf;
+  c.parent = v;
+  c.bundle_edge = e;
+  c.cost = s_.node(v).cost + r.path_length;
+  c.h = s_.heuristic(c.q);
+  const int id = s_.add(c);
+  if (s_.in_goal(c.h)) {
+    found(id);
+  } else {
+    push(id);
+  }
+}
+
+}  // namespace lazyboe

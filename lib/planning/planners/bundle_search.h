@@ -1,0 +1,125 @@
+// The search over bundle edges that BoE and LazyBoE share (internal; not installed): greedy
+// best-first search on the heuristic (distance to the goal), where expanding a node simulates
+// every bundle edge that starts within theta of it, applying the edge's command from the
+// node's own state. LazyBoE (lazyboe.cpp) overrides the hooks below to take edges lazily.
+#pragma once
+
+#include <cstdint>
+#include <queue>
+#include <string>
+#include <unordered_set>
+#include <utility>
+#include <vector>
+
+#include "lazyboe/common/error.h"
+#include "lazyboe/planning/parameters.h"
+#include "lazyboe/planning/rollout_scheduler.h"
+#include "lazyboe/planning/search_tree.h"
+
+namespace lazyboe {
+
+class BundleSearch {
+ public:
+  BundleSearch(const PlanningContext& ctx, SimulatorWorkspace& ws, const PlanningProblem& p,
+               double theta, RolloutPool* pool);
+  virtual ~BundleSearch() = default;
+
+  PlanResult run();
+
+ protected:
+  using Neighbours = std::vector<std::pair<uint32_t, double>>;  // (edge, sort key)
+
+  // ---- Hooks (BoE's behaviour by default) ----
+  // The open list ran dry: true when it was refilled and the search goes on.
+  virtual bool refill() { return false; }
+  // Radius of the neighbourhood expanded from node v.
+  virtual double radius(int /*v*/) { return theta_; }
+  // Node v has no neighbour: true when it was dealt with (and is not expanded now).
+  virtual bool defer(int /*v*/) { return false; }
+  // Called once per expansion, with the neighbours in the order they are visited.
+  virtual void begin_expansion(int /*v*/, const Neighbours& /*neighbours*/) {}
+  // Visits neighbour k (edge e) of the expanded node v; false ends the expansion.
+  virtual bool visit(int v, size_t k, uint32_t e) {
+    simulate_edge(v, e, k);
+    return true;
+  }
+  // Whether neighbour k of the real node v needs a rollout from v in this expansion.
+  virtual bool needs_rollout(int v, size_t k);
+
+  // ---- For the hooks ----
+  void push(int node) { open_.emplace(s_.node(node).h, node); }
+  // A node under a failed lazy ancestor is dead too.
+  bool dead(int v);
+  bool simulated(int v, uint32_t e) const { return simulated_.count(key(v, e)) > 0; }
+  // Simulates edge e from the real node v (k: its place in the expansion) and adds the child.
+  void simulate_edge(int v, uint32_t e, size_t k);
+  // The rollout of neighbour k's edge from node v: from the scheduler when v is the real node
+  // being expanded, else run here.
+  RolloutResult rollout_from(int v, size_t k);
+  void found(int node);
+  double heuristic_at_end(uint32_t e);
+  JointVector edge_end(uint32_t e) const;
+  JointVector edge_start(uint32_t e) const;
+  int expanding() const { return expanding_; }
+  uint32_t expansion_edge(size_t k) const { return (*expansion_)[k].first; }
+
+  const PlanningContext& ctx_;
+  const BundleView& bundle_;
+  SearchState s_;
+  const double theta_;
+
+ private:
+  static uint64_t key(int v, uint32_t e) { return (static_cast<uint64_t>(v) << 32) | e; }
+  bool covered(Neighbours& neighbours);
+  int pop();
+  bool skip(int v);
+  void expand(int v, Neighbours& neighbours);
+  void order_by_promise(Neighbours& edges);
+  bool prunable(int v);
+  std::vector<PathStep> path_to(int node);
+
+  std::unordered_set<uint64_t> simulated_;  // (node, edge) pairs simulated
+  std::priority_queue<std::pair<double, int>, std::vector<std::pair<double, int>>, std::greater<>>
+      open_;
+  int expanding_ = -1;
+  const Neighbours* expansion_ = nullptr;
+  RolloutScheduler ahead_;
+};
+
+// theta, as BoE and LazyBoE declare it (default: the bundle's).
+ParameterSpec theta_parameter();
+
+// Setup shared by the bundle planners: the context must have a bundle and its index (and,
+// with `perturbation`, the perturbation analysis); returns theta (the parameter, else the
+// context's), which must be > 0.
+double bundle_planner_setup(const PlanningContext& context, const ParameterValues& values,
+                            const std::string& planner, bool perturbation);
+
+// A bundle planner: Search (BundleSearch or a subclass) with theta from its parameters or the
+// context.
+template <class Search>
+class BundlePlanner : public Planner {
+ public:
+  BundlePlanner(const ParameterValues& values, std::string name, bool perturbation)
+      : values_(values), name_(std::move(name)), perturbation_(perturbation) {}
+
+  void setup(const PlanningContext& context) override {
+    theta_ = bundle_planner_setup(context, values_, name_, perturbation_);
+    context_ = &context;
+  }
+
+  PlanResult solve(const PlanningProblem& problem, SimulatorWorkspace& ws,
+                   RolloutPool* pool) override {
+    if (!context_) fail(name_, "solve before setup");
+    return Search(*context_, ws, problem, theta_, pool).run();
+  }
+
+ private:
+  ParameterValues values_;
+  std::string name_;
+  bool perturbation_;
+  const PlanningContext* context_ = nullptr;
+  double theta_ = 0;
+};
+
+}  // namespace lazyboe

@@ -1,0 +1,155 @@
+#include "lazyboe/planning/planners/lazyboe.h"
+
+#include <algorithm>
+
+#include "lazyboe/planning/planners/bundle_search.h"
+#include "lazyboe/sim/random.h"
+
+namespace lazyboe {
+namespace {
+
+class LazySearch : public BundleSearch {
+ public:
+  LazySearch(const PlanningContext& ctx, SimulatorWorkspace& ws, const PlanningProblem& p,
+             double theta, RolloutPool* pool)
+      : BundleSearch(ctx, ws, p, theta, pool), rng_(p.seed, 0) {}
+
+ private:
+  // Once the lazy search has run dry, every edge it took lazily is simulated from its node (a
+  // second, exhaustive pass over the real nodes, as BoE would).
+  bool refill() override {
+    if (exhaustive_) return false;
+    exhaustive_ = true;
+    for (size_t u = 0; u < s_.nodes().size(); ++u) {
+      SearchNode& node = s_.nodes()[u];
+      if (node.lazy || node.failed || s_.in_goal(node.h)) continue;
+      node.expanded = false;
+      push(static_cast<int>(u));
+    }
+    return true;
+  }
+
+  double radius(int v) override { return s_.node(v).lazy ? theta_ / 2 : theta_; }
+
+  // The lazy chain cannot go on (nothing starts within theta/2 of its stored end): it
+  // terminates and is simulated; the node goes back to the queue as a real one, keyed by its
+  // simulated heuristic (realize), and competes with the rest before its expansion.
+  bool defer(int v) override {
+    if (!s_.node(v).lazy) return false;
+    realize(v);
+    return true;
+  }
+
+  // P_select draws for the whole neighbourhood up front, so that the rollouts of a real node
+  // can be run ahead, in parallel (RolloutScheduler).
+  void begin_expansion(int, const Neighbours& neighbours) override {
+    lazy_search_ = !exhaustive_;
+    take_lazy_.assign(neighbours.size(), 0);
+    if (!lazy_search_) return;
+    for (size_t k = 0; k < neighbours.size(); ++k) {
+      const uint32_t e = neighbours[k].first;
+      take_lazy_[k] = rng_.uniform() < (1 - bundle_.p_collision(e)) * bundle_.p_lazy_prop(e);
+    }
+  }
+
+  bool visit(int v, size_t k, uint32_t e) override {
+    if (lazy_search_) {
+      if (take_lazy_[k]) {
+        take_lazily(v, e, k);
+        return true;
+      }
+      if (s_.node(v).lazy && !realize(v)) return false;  // simulate the chain up to v first
+    }
+    simulate_edge(v, e, k);
+    return true;
+  }
+
+  // Rollouts from the real node: the edges not taken lazily (and not simulated from it
+  // before), and the lazy ones whose stored end is in the goal region (take_lazily simulates
+  // them at once).
+  bool needs_rollout(int v, size_t k) override {
+    if (!take_lazy_[k]) return BundleSearch::needs_rollout(v, k);
+    return s_.in_goal(heuristic_at_end(expansion_edge(k)));
+  }
+
+  void take_lazily(int v, uint32_t e, size_t k);
+  bool realize(int x, long k = -1);
+
+  Random rng_;
+  bool exhaustive_ = false;
+  bool lazy_search_ = false;
+  std::vector<char> take_lazy_;
+};
+
+void LazySearch::take_lazily(int v, uint32_t e, size_t k) {
+  ++s_.result().counters.lazy_edges;
+  SearchNode c;
+  c.q = edge_end(e);
+  c.parent = v;
+  c.bundle_edge = e;
+  c.lazy = true;
+  c.cost = s_.node(v).cost + (edge_end(e) - edge_start(e)).norm();
+  c.h = s_.heuristic(c.q);
+  const int id = s_.add(c);
+  // SHOULD_TERMINATE_LAZY: the lazy path reaches the goal region (simulate it, the child
+  // included), or the heuristic rises again (simulate the chain up to the parent, which was
+  // the best point of it; the child waits in the queue). A tie counts as rising: an edge
+  // whose stored end lies within theta/2 of its own start can be taken again from that end,
+  // and a chain without progress would otherwise grow forever for free.
+  if (s_.in_goal(c.h)) {
+    realize(id, static_cast<long>(k));
+  } else if (c.h >= s_.node(v).h && s_.node(v).lazy) {
+    if (realize(v)) push(id);
+  } else {
+    push(id);
+  }
+}
+
+// Simulates the lazy chain ending at `x` from its last simulated ancestor. Nodes that pass
+// become real (their state the simulated end); the first failure kills the rest of the chain.
+// `k`: x is the lazy child of the expanded node for its neighbour k (a one-edge chain).
+bool LazySearch::realize(int x, long k) {
+  std::vector<int> chain;
+  for (int u = x; s_.node(u).lazy; u = s_.node(u).parent) chain.push_back(u);
+  std::reverse(chain.begin(), chain.end());
+  for (int u : chain) {
+    const int parent = s_.node(u).parent;
+    const RolloutResult r =
+        k >= 0 && chain.size() == 1 && parent == expanding()
+            ? rollout_from(parent, static_cast<size_t>(k))
+            : s_.simulate_from(s_.node(parent).q, bundle_.command(s_.node(u).bundle_edge));
+    if (!r.valid()) {
+      s_.node(u).failed = true;
+      return false;
+    }
+    SearchNode& n = s_.node(u);
+    n.q = r.qf;
+    n.lazy = false;
+    n.cost = s_.node(parent).cost + r.path_length;
+    n.h = s_.heuristic(n.q);
+    if (s_.in_goal(n.h)) {
+      found(u);
+    } else if (!n.expanded) {
+      push(u);  // re-queued with its real heuristic
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
+PlannerInfo lazyboe_planner_info() {
+  PlannerInfo info;
+  info.name = "lazyboe";
+  info.description =
+      "LazyBoE: BoE taking edges lazily with P_select = (1 - P_collision) P_lazy_prop";
+  info.needs.bundle = true;
+  info.needs.perturbation = true;
+  info.parameters = {theta_parameter()};
+  info.make = [](const ParameterValues& v) {
+    return std::make_unique<BundlePlanner<LazySearch>>(v, "lazyboe", true);
+  };
+  return info;
+}
+
+}  // namespace lazyboe

@@ -1,0 +1,117 @@
+#include "lazyboe/planning/planners/sst.h"
+
+#include <limits>
+
+#include "lazyboe/planning/planners/tree_search.h"
+
+namespace lazyboe {
+namespace {
+
+class SstSearch : public TreeSearch {
+ public:
+  SstSearch(const PlanningContext& ctx, SimulatorWorkspace& ws, const PlanningProblem& p,
+            const ParameterValues& values)
+      : TreeSearch(ctx, ws, p, values),
+        delta_bn_(values.get("selection_radius")),
+        delta_s_(values.get("pruning_ratio") * values.get("selection_radius")) {}
+
+ private:
+  struct Witness {
+    JointVector q;
+    int representative;
+  };
+
+  void start(const SearchNode& root) override { witnesses_.push_back({root.q, 0}); }
+
+  // Best-Near: the lowest-cost active node within delta_BN, else the nearest.
+  int select(const JointVector& x) override {
+    int best = -1;
+    double best_cost = std::numeric_limits<double>::infinity();
+    const std::vector<SearchNode>& nodes = s_.nodes();
+    for (size_t v = 0; v < nodes.size(); ++v) {
+      if (nodes[v].pruned || nodes[v].inactive) continue;
+      if ((nodes[v].q - x).norm() <= delta_bn_ && nodes[v].cost < best_cost) {
+        best_cost = nodes[v].cost;
+        best = static_cast<int>(v);
+      }
+    }
+    return best >= 0 ? best : nearest(x);
+  }
+
+  // A node joins when it is the first or the cheapest near its witness (a new witness when
+  // none is within delta_s); the representative it replaces becomes inactive.
+  bool admit(const SearchNode& c) override {
+    witness_ = nearest_witness(c.q);
+    if (witness_ < 0 || (witnesses_[witness_].q - c.q).norm() > delta_s_) {
+      witnesses_.push_back({c.q, -1});
+      witness_ = static_cast<int>(witnesses_.size()) - 1;
+    }
+    const int rep = witnesses_[witness_].representative;
+    if (rep >= 0 && s_.node(rep).cost <= c.cost) return false;  // not better locally: drop
+    if (rep >= 0) {
+      s_.node(rep).inactive = true;
+      prune_upwards(rep);
+    }
+    return true;
+  }
+
+  void added(int id) override { witnesses_[witness_].representative = id; }
+  bool stop_at_solution() const override { return false; }
+
+  int nearest_witness(const JointVector& q) const {
+    int best = -1;
+    double best_d = std::numeric_limits<double>::infinity();
+    for (size_t w = 0; w < witnesses_.size(); ++w) {
+      const double d = (witnesses_[w].q - q).squaredNorm();
+      if (d < best_d) {
+        best_d = d;
+        best = static_cast<int>(w);
+      }
+    }
+    return best;
+  }
+
+  const double delta_bn_, delta_s_;
+  std::vector<Witness> witnesses_;
+  int witness_ = -1;  // of the node being admitted
+};
+
+}  // namespace
+
+ParameterSpec selection_radius_parameter() {
+  ParameterSpec p;
+  p.name = "selection_radius";
+  p.default_value = 0.2;
+  p.lower = 0;
+  p.lower_exclusive = true;
+  p.description = "SST's selection radius delta_BN, rad";
+  return p;
+}
+
+ParameterSpec pruning_ratio_parameter() {
+  ParameterSpec p;
+  p.name = "pruning_ratio";
+  p.default_value = 1.0;
+  p.lower = 0;
+  p.lower_exclusive = true;
+  p.description = "SST's pruning radius delta_s as a multiple of the selection radius";
+  return p;
+}
+
+PlannerInfo sst_planner_info() {
+  PlannerInfo info;
+  info.name = "sst";
+  info.description = "Stable Sparse RRT: Best-Near selection and witness pruning; anytime";
+  info.parameters = {goal_bias_parameter(), selection_radius_parameter(),
+                     pruning_ratio_parameter()};
+  for (double ratio : {0.5, 1.0, 2.0}) {
+    const std::string suffix = ratio == 0.5 ? "0.5x" : ratio == 1.0 ? "1x" : "2x";
+    info.study_variants.push_back({"sst-" + suffix, {{"pruning_ratio", ratio}}});
+  }
+  info.make = [](const ParameterValues& v) {
+    return std::make_unique<TreePlanner<SstSearch>>(v, "sst");
+  };
+  return info;
+}
+
+}  // namespace lazyboe

@@ -1,0 +1,111 @@
+#include "lazyboe/planning/planners/tree_search.h"
+
+#include <algorithm>
+#include <limits>
+
+namespace lazyboe {
+
+ParameterSpec goal_bias_parameter() {
+  ParameterSpec p;
+  p.name = "goal_bias";
+  p.default_value = 0.05;
+  p.lower = 0;
+  p.upper = 1;
+  p.description = "probability of sampling the goal (joint goals) instead of a random state";
+  return p;
+}
+
+void check_sampling_box(const PlanningContext& ctx, const std::string& planner) {
+  const int n = ctx.sim.robot.dof;
+  if (ctx.sample_lower.size() != n || ctx.sample_upper.size() != n) {
+    fail("planner", planner + " needs a sampling box of " + std::to_string(n) + " joints");
+  }
+}
+
+TreeSearch::TreeSearch(const PlanningContext& ctx, SimulatorWorkspace& ws, const PlanningProblem& p,
+                       const ParameterValues& values)
+    : ctx_(ctx), s_(ctx, ws, p), rng_(p.seed, 1), goal_bias_(values.get("goal_bias")) {}
+
+PlanResult TreeSearch::run() {
+  const int n = ctx_.sim.robot.dof;
+  SearchNode root;
+  root.q = s_.problem().start;
+  root.h = s_.heuristic(root.q);
+  s_.add(root);
+  children_.push_back(0);
+  start(root);
+  JointVector x(n);
+  std::vector<double> knots;
+  while (!s_.should_stop()) {
+    sample(x);
+    const int from = select(x);
+    const double duration = sample_command_profile(ctx_.sim.robot, ctx_.command, rng_, knots);
+    const CommandProfile profile{knots.data(), static_cast<int>(knots.size() / n), n, duration};
+    const RolloutResult r = s_.simulate_from(s_.node(from).q, profile);
+    if (!r.valid()) continue;
+    SearchNode c;
+    c.q = r.qf;
+    c.parent = from;
+    c.cost = s_.node(from).cost + r.path_length;
+    c.h = s_.heuristic(c.q);
+    if (!admit(c)) continue;
+    c.command = static_cast<int>(commands_.size());
+    commands_.push_back({-1, knots, duration});
+    const int id = s_.add(c);
+    children_.push_back(0);
+    ++children_[from];
+    added(id);
+    if (s_.in_goal(c.h)) {
+      s_.solution(id, [this](int u) { return path_to(u); });
+      if (stop_at_solution()) break;
+    }
+  }
+  PlanResult& result = s_.result();
+  if (!result.success) result.failure = "no solution within the time budget";
+  return result;
+}
+
+void TreeSearch::sample(JointVector& x) {
+  const PlanningProblem& p = s_.problem();
+  if (p.goal.kind == Goal::Kind::Joint && rng_.uniform() < goal_bias_) {
+    x = p.goal.q;
+    return;
+  }
+  for (int i = 0; i < x.size(); ++i)
+    x[i] = rng_.uniform(ctx_.sample_lower[i], ctx_.sample_upper[i]);
+}
+
+int TreeSearch::nearest(const JointVector& x) {
+  int best = 0;
+  double best_d = std::numeric_limits<double>::infinity();
+  const std::vector<SearchNode>& nodes = s_.nodes();
+  for (size_t v = 0; v < nodes.size(); ++v) {
+    if (nodes[v].pruned || nodes[v].inactive) continue;
+    const double d = (nodes[v].q - x).squaredNorm();
+    if (d < best_d) {
+      best_d = d;
+      best = static_cast<int>(v);
+    }
+  }
+  return best;
+}
+
+void TreeSearch::prune_upwards(int v) {
+  std::vector<SearchNode>& nodes = s_.nodes();
+  while (v > 0 && nodes[v].inactive && !nodes[v].pruned && children_[v] == 0) {
+    nodes[v].pruned = true;
+    const int parent = nodes[v].parent;
+    --children_[parent];
+    v = parent;
+  }
+}
+
+std::vector<PathStep> TreeSearch::path_to(int node) {
+  std::vector<PathStep> steps;
+  for (int u = node; s_.node(u).parent >= 0; u = s_.node(u).parent)
+    steps.push_back(commands_[s_.node(u).command]);
+  std::reverse(steps.begin(), steps.end());
+  return steps;
+}
+
+}  // namespace lazyboe

@@ -1,0 +1,86 @@
+// The tree search that RRT and SST share (internal; not installed): sample a state in the
+// context's sampling box (or, with probability goal_bias, a joint goal), select a tree node for
+// it, apply a random command of the context's command family from that node, and add the end
+// state when the rollout is valid. SST (sst.cpp) overrides the hooks.
+#pragma once
+
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "lazyboe/common/error.h"
+#include "lazyboe/planning/parameters.h"
+#include "lazyboe/planning/search_tree.h"
+#include "lazyboe/sim/random.h"
+
+namespace lazyboe {
+
+class TreeSearch {
+ public:
+  TreeSearch(const PlanningContext& ctx, SimulatorWorkspace& ws, const PlanningProblem& p,
+             const ParameterValues& values);
+  virtual ~TreeSearch() = default;
+
+  PlanResult run();
+
+ protected:
+  // ---- Hooks (RRT's behaviour by default) ----
+  virtual void start(const SearchNode& /*root*/) {}
+  // The tree node to extend towards the sample x.
+  virtual int select(const JointVector& x) { return nearest(x); }
+  // Whether the new node c (not yet added) joins the tree.
+  virtual bool admit(const SearchNode& /*c*/) { return true; }
+  // Called once the admitted node is in the tree as `id`.
+  virtual void added(int /*id*/) {}
+  // RRT stops at its first solution.
+  virtual bool stop_at_solution() const { return true; }
+
+  // The nearest live node.
+  int nearest(const JointVector& x);
+  // The node and its now childless ancestors, upwards, are removed from the tree while
+  // inactive (SST's pruning).
+  void prune_upwards(int v);
+
+  const PlanningContext& ctx_;
+  SearchState s_;
+  Random rng_;
+
+ private:
+  void sample(JointVector& x);
+  std::vector<PathStep> path_to(int node);
+
+  double goal_bias_;
+  std::vector<PathStep> commands_;
+  std::vector<int> children_;
+};
+
+// The context must have a sampling box of robot.dof joints.
+void check_sampling_box(const PlanningContext& context, const std::string& planner);
+
+// A sampling planner: Search (TreeSearch or a subclass) with its parameter values.
+template <class Search>
+class TreePlanner : public Planner {
+ public:
+  TreePlanner(const ParameterValues& values, std::string name)
+      : values_(values), name_(std::move(name)) {}
+
+  void setup(const PlanningContext& context) override {
+    check_sampling_box(context, name_);
+    context_ = &context;
+  }
+
+  PlanResult solve(const PlanningProblem& problem, SimulatorWorkspace& ws, RolloutPool*) override {
+    if (!context_) fail(name_, "solve before setup");
+    return Search(*context_, ws, problem, values_).run();
+  }
+
+ private:
+  ParameterValues values_;
+  std::string name_;
+  const PlanningContext* context_ = nullptr;
+};
+
+// goal_bias, as RRT and SST (ours and OMPL's) declare it.
+ParameterSpec goal_bias_parameter();
+
+}  // namespace lazyboe

@@ -1,0 +1,140 @@
+#include "lazyboe/planning/registry.h"
+
+#include <algorithm>
+#include <sstream>
+
+#include "lazyboe/common/error.h"
+#include "lazyboe/planning/ompl/ompl_planners.h"
+#include "lazyboe/planning/planners/boe.h"
+#include "lazyboe/planning/planners/lazyboe.h"
+#include "lazyboe/planning/planners/rrt.h"
+#include "lazyboe/planning/planners/sst.h"
+
+namespace lazyboe {
+
+const std::vector<PlannerInfo>& planner_registry() {
+  static const std::vector<PlannerInfo> registry = {
+      lazyboe_planner_info(),  // the paper's planner first: the default
+      boe_planner_info(),      rrt_planner_info(),      sst_planner_info(),
+      ompl_rrt_planner_info(), ompl_sst_planner_info(), ompl_kpiece_planner_info(),
+  };
+  return registry;
+}
+
+const ParameterSpec* PlannerInfo::parameter(const std::string& key) const {
+  for (const ParameterSpec& p : parameters)
+    if (p.name == key) return &p;
+  return nullptr;
+}
+
+bool PlannerInfo::available(std::string* why) const {
+  if (needs.ompl && !ompl_available()) {
+    if (why) *why = "built without OMPL (install libompl-dev and rebuild)";
+    return false;
+  }
+  return true;
+}
+
+const PlannerInfo* find_planner(const std::string& name) {
+  for (const PlannerInfo& info : planner_registry())
+    if (info.name == name) return &info;
+  return nullptr;
+}
+
+const PlannerInfo& planner_info(const std::string& name, const std::string& where) {
+  const PlannerInfo* info = find_planner(name);
+  if (!info) fail(where, "unknown planner '" + name + "' (expected " + planner_names_text() + ")");
+  return *info;
+}
+
+std::string planner_names_text() {
+  const std::vector<PlannerInfo>& all = planner_registry();
+  std::string text;
+  for (size_t k = 0; k < all.size(); ++k) {
+    if (k > 0) text += k + 1 == all.size() ? " or " : ", ";
+    text += all[k].name;
+  }
+  return text;
+}
+
+std::vector<std::string> all_parameter_names() {
+  std::vector<std::string> names;
+  for (const PlannerInfo& info : planner_registry()) {
+    for (const ParameterSpec& p : info.parameters) {
+      if (std::find(names.begin(), names.end(), p.name) == names.end()) names.push_back(p.name);
+    }
+  }
+  return names;
+}
+
+std::unique_ptr<Planner> make_planner(const std::string& name, const ParameterValues& values) {
+  const PlannerInfo& info = planner_info(name);
+  ParameterValues resolved;
+  for (const auto& [key, value] : values.all()) {
+    const ParameterSpec* spec = info.parameter(key);
+    if (!spec) fail(name, "no parameter '" + key + "'");
+    const std::string why = spec->check(value);
+    if (!why.empty()) fail(key, why);
+    resolved.set(key, value);
+  }
+  for (const ParameterSpec& p : info.parameters) {
+    if (!resolved.has(p.name) && p.has_fixed_default()) resolved.set(p.name, p.default_value);
+  }
+  return info.make(resolved);
+}
+
+namespace {
+
+std::string needs_text(const PlannerInfo& info) {
+  std::vector<std::string> needs;
+  if (info.needs.bundle) needs.push_back("an edge bundle");
+  if (info.needs.perturbation) needs.push_back("its perturbation analysis");
+  if (info.needs.ompl) needs.push_back("OMPL");
+  if (needs.empty()) return "a simulator (the bundle's sampling region and commands)";
+  std::string text;
+  for (size_t k = 0; k < needs.size(); ++k) text += (k == 0 ? "" : ", ") + needs[k];
+  return text;
+}
+
+const char* type_name(ParameterType t) {
+  switch (t) {
+    case ParameterType::Integer:
+      return "integer";
+    case ParameterType::Boolean:
+      return "boolean";
+    default:
+      return "real";
+  }
+}
+
+}  // namespace
+
+std::string planner_list_text() {
+  std::ostringstream o;
+  for (const PlannerInfo& info : planner_registry()) {
+    std::string why;
+    o << info.name << ": " << info.description << "\n";
+    o << "  needs: " << needs_text(info);
+    if (!info.available(&why)) o << " (not available: " << why << ")";
+    o << "\n";
+    for (const ParameterSpec& p : info.parameters) {
+      o << "  " << p.name << " (" << type_name(p.type) << ", " << p.range_text() << ", default "
+        << p.default_text() << "): " << p.description << "\n";
+    }
+    if (!info.study_variants.empty()) {
+      o << "  study variants:";
+      for (const PlannerVariant& v : info.study_variants) o << " " << v.name;
+      o << "\n";
+    }
+  }
+  return o.str();
+}
+
+PlanResult plan(const PlanningContext& context, SimulatorWorkspace& ws, const std::string& planner,
+                const ParameterValues& values, const PlanningProblem& problem, RolloutPool* pool) {
+  const std::unique_ptr<Planner> p = make_planner(planner, values);
+  p->setup(context);
+  return p->solve(problem, ws, pool);
+}
+
+}  // namespace lazyboe

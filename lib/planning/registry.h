@@ -1,0 +1,74 @@
+// The planner registry: each planner once, with its name, description, needs, parameters and
+// factory. Query parsing, the query schema's planner list (checked by a test), lazyboe-bench's
+// planners and `lazyboe-query --list-planners` all come from it. Adding a planner: one file
+// pair under planners/ that defines its PlannerInfo, and one line in registry.cpp.
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "lazyboe/planning/parameters.h"
+#include "lazyboe/planning/planner.h"
+
+namespace lazyboe {
+
+struct PlannerNeeds {
+  bool bundle = false;        // an edge bundle and its neighbour index
+  bool perturbation = false;  // the bundle's perturbation analysis (lazyboe-perturb)
+  bool ompl = false;          // a build with OMPL
+};
+
+// A named setting of a planner's parameters that studies run as a planner of its own (SST's
+// pruning-to-selection ratios of the paper: sst-0.5x, sst-1x, sst-2x).
+struct PlannerVariant {
+  std::string name;
+  ParameterValues values;
+};
+
+struct PlannerInfo {
+  std::string name;
+  std::string description;  // one line
+  PlannerNeeds needs;
+  std::vector<ParameterSpec> parameters;
+  std::vector<PlannerVariant> study_variants;  // empty: studies run the planner itself
+  // Makes the planner from values for every parameter with a fixed default (make_planner
+  // fills those in); parameters with a context default may be missing.
+  std::function<std::unique_ptr<Planner>(const ParameterValues&)> make;
+
+  const ParameterSpec* parameter(const std::string& name) const;
+  // False when the planner is not built in (OMPL's, without OMPL); `why` says so.
+  bool available(std::string* why = nullptr) const;
+};
+
+// Every planner, in the order they are listed.
+const std::vector<PlannerInfo>& planner_registry();
+
+// The planner of that name, or null.
+const PlannerInfo* find_planner(const std::string& name);
+// The same, throwing Error("<where>: unknown planner 'x' (expected lazyboe, boe, ...)").
+const PlannerInfo& planner_info(const std::string& name, const std::string& where = "planner");
+
+// "lazyboe, boe, rrt, sst, ompl-rrt, ompl-sst or ompl-kpiece".
+std::string planner_names_text();
+
+// Every parameter name any planner declares, each once.
+std::vector<std::string> all_parameter_names();
+
+// A planner with `values` checked against its declarations (Error("<name>: must be > 0") for
+// a value out of range, Error("<planner>: no parameter 'x'") for one it does not declare) and
+// the fixed defaults filled in.
+std::unique_ptr<Planner> make_planner(const std::string& name, const ParameterValues& values);
+
+// The registry as text, for `lazyboe-query --list-planners`: per planner its name,
+// description, needs (and whether it is built in), and its parameters with type, default,
+// range and description.
+std::string planner_list_text();
+
+// One query from start to finish: make_planner, setup, solve.
+PlanResult plan(const PlanningContext& context, SimulatorWorkspace& ws, const std::string& planner,
+                const ParameterValues& values, const PlanningProblem& problem,
+                RolloutPool* pool = nullptr);
+
+}  // namespace lazyboe

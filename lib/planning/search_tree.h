@@ -1,0 +1,92 @@
+// Bookkeeping every search of ours shares: the tree's nodes, the solutions found, the
+// counters, the clock. Internal to the planners (not installed).
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include "lazyboe/planning/planner.h"
+
+namespace lazyboe {
+
+struct SearchNode {
+  JointVector q;  // state at rest; for a lazy node, the stored end of its edge
+  int parent = -1;
+  int64_t bundle_edge = -1;  // bundle planners: the edge from the parent
+  int command = -1;          // sampling planners: index into the search's own commands
+  double cost = 0;           // arc length from the start (estimated for lazy nodes)
+  double h = 0;              // heuristic: distance to the goal
+  bool lazy = false;         // LazyBoE: taken without simulation
+  bool failed = false;       // LazyBoE: its simulation failed, so its lazy subtree is dead
+  bool pruned = false;       // SST: removed from the tree
+  bool inactive = false;     // SST: no longer the representative of its witness
+  bool expanded = false;
+};
+
+class SearchState {
+ public:
+  SearchState(const PlanningContext& ctx, SimulatorWorkspace& ws, const PlanningProblem& p)
+      : ctx_(ctx),
+        ws_(ws),
+        problem_(p),
+        deadline_(p.termination.budget),
+        goal_data_(ctx.sim.robot) {}
+
+  const PlanningContext& context() const { return ctx_; }
+  const PlanningProblem& problem() const { return problem_; }
+  const Deadline& deadline() const { return deadline_; }
+  std::vector<SearchNode>& nodes() { return nodes_; }
+  SearchNode& node(int v) { return nodes_[v]; }
+  PlanResult& result() { return result_; }
+
+  double heuristic(const JointVectorRef& q) {
+    return problem_.goal.distance(ctx_.sim.robot, goal_data_, q);
+  }
+  bool in_goal(double h) const { return h <= problem_.goal.tolerance; }
+
+  int add(SearchNode n) {
+    nodes_.push_back(std::move(n));
+    ++result_.counters.nodes;
+    return static_cast<int>(nodes_.size()) - 1;
+  }
+
+  RolloutResult simulate_from(const JointVectorRef& q, const CommandProfile& profile) {
+    const RolloutResult r = simulate(ctx_.sim, ws_, q, profile);
+    count(r);
+    return r;
+  }
+  // Counts a rollout the search uses (run here, or ahead of time by a RolloutPool).
+  void count(const RolloutResult& r) {
+    ++result_.counters.simulations;
+    result_.counters.collision_checks += r.collision_checks;
+  }
+
+  // A real node inside the goal region: a solution. `path_to` gives a node's path.
+  void solution(int node, const std::function<std::vector<PathStep>(int)>& path_to) {
+    ++result_.n_solutions;
+    if (!result_.success) {
+      result_.success = true;
+      result_.time_to_first_solution = deadline_.elapsed();
+    }
+    if (!(nodes_[node].cost >= result_.best_cost)) {  // also when best_cost is NaN
+      result_.best_cost = nodes_[node].cost;
+      result_.best_path = path_to(node);
+    }
+  }
+
+  bool should_stop() const {
+    return deadline_.passed() || (problem_.termination.stop_at_first && result_.success);
+  }
+
+ private:
+  const PlanningContext& ctx_;
+  SimulatorWorkspace& ws_;
+  const PlanningProblem& problem_;
+  Deadline deadline_;
+  RobotData goal_data_;
+  std::vector<SearchNode> nodes_;
+  PlanResult result_;
+};
+
+}  // namespace lazyboe
