@@ -1,5 +1,6 @@
 // The edge bundle's HDF5 file: round trips, contiguous storage for memory-mapping, crash-safe
-// rewrites and one-line errors for every kind of bad file.
+// rewrites and one-line errors for every kind of bad file; a BundleView of a file and of the
+// same bundle in memory.
 #include <fcntl.h>
 #include <gtest/gtest.h>
 #include <signal.h>
@@ -7,13 +8,16 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <functional>
+#include <memory>
 #include <random>
 #include <thread>
 
 #include "lazyboe/bundle/bundle_file.h"
+#include "lazyboe/bundle/bundle_view.h"
 #include "lazyboe/bundle/hdf5_handle.h"
 #include "lazyboe/common/error.h"
 #include "lazyboe/common/hash.h"
@@ -526,6 +530,154 @@ TEST(BundleFile, RejectedAttributesMustPair) {
   });
   expect_error(error_of([&] { read_bundle_header(path); }), path,
                {"rejected_counts", "rejected_reasons"});
+}
+
+// ---- BundleView from a file and from memory -------------------------------------------------
+
+// A bundle a view accepts: random_bundle with at least two knots per edge (the view refuses
+// fewer) and a finished perturbation analysis.
+Bundle viewable_bundle(size_t n, int dof, uint64_t seed) {
+  Bundle b = random_bundle(n, dof, seed);
+  std::mt19937_64 rng(seed + 1);
+  std::uniform_real_distribution<double> u(-3.0, 3.0);
+  b.knots.clear();
+  b.knot_offset = {0};
+  for (size_t k = 0; k < n; ++k) {
+    const uint64_t nk = 2 + k % 4;
+    for (uint64_t r = 0; r < nk * static_cast<uint64_t>(dof); ++r) b.knots.push_back(u(rng));
+    b.knot_offset.push_back(b.knot_offset.back() + nk);
+  }
+  Perturbation& p = b.perturbation;
+  p.present = true;
+  p.complete = true;
+  p.theta = 0.3;
+  p.perturbations = 4;
+  p.seed = 5;
+  for (size_t k = 0; k < n; ++k) {
+    const uint64_t valid = k % 5, lazy = valid / 2, collision = 4 - valid;
+    p.done.push_back(4);
+    p.valid.push_back(valid);
+    p.lazy.push_back(lazy);
+    p.collision.push_back(collision);
+    p.max_error.push_back(valid ? u(rng) + 3 : std::nan(""));
+    p.p_lazy_prop.push_back(valid ? static_cast<double>(lazy) / valid : 0.0);
+    p.p_collision.push_back(collision / 4.0);
+  }
+  return b;
+}
+
+// The first edge (and what) on which two views differ; "" when they agree bit for bit.
+std::string view_difference(const BundleView& a, const BundleView& b) {
+  if (a.size() != b.size()) return "size";
+  if (a.dof() != b.dof()) return "dof";
+  if (a.has_perturbation() != b.has_perturbation()) return "has_perturbation";
+  if (!same_bits(a.perturbation_theta(), b.perturbation_theta())) return "perturbation_theta";
+  const size_t n = static_cast<size_t>(a.dof());
+  for (size_t e = 0; e < a.size(); ++e) {
+    const std::string at = " of edge " + std::to_string(e);
+    if (std::memcmp(a.q0(e), b.q0(e), n * sizeof(double)) != 0) return "q0" + at;
+    if (std::memcmp(a.qf(e), b.qf(e), n * sizeof(double)) != 0) return "qf" + at;
+    if (!same_bits(a.duration(e), b.duration(e))) return "duration" + at;
+    const CommandProfile ca = a.command(e), cb = b.command(e);
+    if (ca.n_knots != cb.n_knots || ca.dof != cb.dof || !same_bits(ca.duration, cb.duration) ||
+        std::memcmp(ca.knots, cb.knots, ca.n_knots * n * sizeof(double)) != 0) {
+      return "command" + at;
+    }
+    if (a.has_perturbation()) {
+      if (!same_bits(a.p_lazy_prop(e), b.p_lazy_prop(e))) return "p_lazy_prop" + at;
+      if (!same_bits(a.p_collision(e), b.p_collision(e))) return "p_collision" + at;
+    }
+  }
+  return "";
+}
+
+TEST(BundleView, FromMemoryEqualsTheSameBundleOpenedFromItsFile) {
+  const auto bundle = std::make_shared<const Bundle>(viewable_bundle(40, 7, 11));
+  const std::string path = fresh_path("view-memory");
+  write_bundle(path, *bundle);
+  const BundleView mapped = BundleView::open(path, true);
+  const BundleView read = BundleView::open(path, false);
+  const BundleView memory = BundleView::from_memory(bundle, "in-memory test bundle");
+  EXPECT_EQ(memory.path(), "in-memory test bundle");
+  EXPECT_FALSE(memory.memory_mapped());
+  EXPECT_TRUE(memory.warnings().empty());
+  ASSERT_EQ(memory.size(), 40u);
+  ASSERT_TRUE(memory.has_perturbation());
+  EXPECT_EQ(view_difference(mapped, memory), "");
+  EXPECT_EQ(view_difference(read, memory), "");
+  expect_same_header(mapped.header(), memory.header());
+  // A view into the bundle's own arrays, kept alive by the view alone.
+  EXPECT_EQ(memory.q0(0), bundle->q0.data());
+  std::weak_ptr<const Bundle> watch;
+  std::unique_ptr<BundleView> only;
+  {
+    const auto copy = std::make_shared<const Bundle>(*bundle);
+    watch = copy;
+    only = std::make_unique<BundleView>(BundleView::from_memory(copy, "copy"));
+  }
+  EXPECT_FALSE(watch.expired());
+  EXPECT_EQ(view_difference(*only, memory), "");
+  only.reset();
+  EXPECT_TRUE(watch.expired());
+}
+
+TEST(BundleView, FromMemoryUsesOnlyAFinishedPerturbationAsOpenDoes) {
+  Bundle b = viewable_bundle(10, 7, 12);
+  b.perturbation.complete = false;
+  const std::string path = fresh_path("view-unfinished");
+  write_bundle(path, b);
+  const BundleView file = BundleView::open(path);
+  const BundleView memory =
+      BundleView::from_memory(std::make_shared<const Bundle>(b), "unfinished analysis");
+  EXPECT_FALSE(file.has_perturbation());
+  EXPECT_FALSE(memory.has_perturbation());
+  EXPECT_EQ(memory.warnings(), file.warnings());
+  EXPECT_EQ(view_difference(file, memory), "");
+  b.perturbation = Perturbation{};
+  EXPECT_FALSE(
+      BundleView::from_memory(std::make_shared<const Bundle>(b), "none").has_perturbation());
+}
+
+TEST(BundleView, FromMemoryRefusesIncompleteAndInconsistentBundles) {
+  const Bundle good = viewable_bundle(10, 7, 13);
+  ASSERT_NO_THROW(BundleView::from_memory(std::make_shared<const Bundle>(good), "good"));
+  const std::string name = "spoilt in-memory bundle";
+  struct Case {
+    std::function<void(Bundle&)> spoil;
+    std::vector<std::string> parts;
+  };
+  const std::vector<Case> cases = {
+      {[](Bundle& b) { b.header.complete = false; }, {"incomplete bundle", "--resume"}},
+      {[](Bundle& b) { b.header.dof = 0; }, {"bundle.header.dof"}},
+      {[](Bundle& b) { b.header.schema_version = 2; }, {"bundle.header.schema_version"}},
+      {[](Bundle& b) { b.q0.push_back(1); }, {"bundle.q0", "71", "70"}},
+      {[](Bundle& b) { b.duration.pop_back(); }, {"bundle.q0"}},
+      {[](Bundle& b) { b.knot_offset.pop_back(); }, {"bundle.knot_offset", "edges + 1"}},
+      {[](Bundle& b) { b.knot_offset.back() += 1; },
+       {"bundle.knot_offset", "last value", "bundle.knots"}},
+      {[](Bundle& b) { b.knots.pop_back(); }, {"bundle.knots", "multiple of dof"}},
+      {[](Bundle& b) { b.perturbation.p_lazy_prop.pop_back(); },
+       {"bundle.perturbation.p_lazy_prop"}},
+      {[](Bundle& b) { b.perturbation.p_collision.push_back(0); },
+       {"bundle.perturbation.p_collision"}},
+      // Consistent for check_bundle, but an edge of one knot is no command.
+      {[](Bundle& b) {
+         b.knot_offset[1] = 1;
+         for (size_t k = 0; k < 7; ++k) b.knots.erase(b.knots.begin());
+         for (size_t e = 2; e < b.knot_offset.size(); ++e) b.knot_offset[e] -= 1;
+       },
+       {"knot_offset", "edge 0", "bad knot range"}},
+  };
+  for (const Case& c : cases) {
+    Bundle b = good;
+    c.spoil(b);
+    const std::string message =
+        error_of([&] { BundleView::from_memory(std::make_shared<const Bundle>(b), name); });
+    expect_error(message, name, {});
+    for (const std::string& part : c.parts)
+      EXPECT_NE(message.find(part), std::string::npos) << message;
+  }
+  expect_error(error_of([&] { BundleView::from_memory(nullptr, name); }), name, {"no bundle"});
 }
 
 }  // namespace

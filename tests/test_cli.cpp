@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "cli_util.h"
 #include "lazyboe/collision/collision_model.h"
 #include "lazyboe/collision/environment.h"
 #include "lazyboe/io/csv.h"
@@ -28,12 +29,6 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-std::string quote(const std::string& s) {
-  std::string out = "'";
-  for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return out + "'";
-}
-
 // Runs lazyboe-robot with the given arguments (each is shell-quoted).
 CommandResult robot_tool(const std::vector<std::string>& args) {
   std::string cmd = quote(tool_path("lazyboe-robot"));
@@ -42,31 +37,6 @@ CommandResult robot_tool(const std::vector<std::string>& args) {
 }
 
 std::string table_env() { return source_path("data/environments/table.json"); }
-
-std::string describe(const CommandResult& r) {
-  return "exit " + std::to_string(r.exit_code) + "\n--- stdout:\n" + r.out + "--- stderr:\n" +
-         r.err;
-}
-
-long count_lines(const std::string& s) { return std::count(s.begin(), s.end(), '\n'); }
-
-// A failure as the tools promise it: a normal non-zero exit (no signal, no abort), nothing on
-// stdout, and exactly one line on stderr that contains every one of `needles`.
-void expect_one_line_error(const CommandResult& r, const std::vector<std::string>& needles) {
-  std::string problems;
-  if (r.exit_code == 0) problems += "  exit status 0 (expected failure)\n";
-  if (r.exit_code < 0 || r.exit_code >= 128)
-    problems += "  exit status looks like a signal or crash\n";
-  if (count_lines(r.err) != 1 || r.err.empty() || r.err.back() != '\n') {
-    problems +=
-        "  expected exactly one line on stderr, got " + std::to_string(count_lines(r.err)) + "\n";
-  }
-  if (!r.out.empty()) problems += "  stdout is not empty\n";
-  for (const std::string& n : needles) {
-    if (r.err.find(n) == std::string::npos) problems += "  stderr does not mention '" + n + "'\n";
-  }
-  EXPECT_TRUE(problems.empty()) << problems << describe(r);
-}
 
 // Replaces the first occurrence of `from`; the edit must apply, or the test means nothing.
 std::string replace_once(const std::string& text, const std::string& from, const std::string& to) {
@@ -179,13 +149,6 @@ JointVector make_q(std::initializer_list<double> values) {
   int i = 0;
   for (double v : values) q[i++] = v;
   return q;
-}
-
-std::vector<std::string> files_in(const std::string& dir) {
-  std::vector<std::string> out;
-  for (const auto& e : fs::directory_iterator(dir)) out.push_back(e.path().filename().string());
-  std::sort(out.begin(), out.end());
-  return out;
 }
 
 // ------------------------------------------------------------------------------------------

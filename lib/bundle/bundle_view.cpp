@@ -7,6 +7,7 @@
 
 #include <cerrno>
 #include <cstring>
+#include <utility>
 
 #include "lazyboe/bundle/bundle_file.h"
 #include "lazyboe/bundle/hdf5_handle.h"
@@ -85,27 +86,64 @@ BundleView BundleView::open(const std::string& path, bool allow_mmap) {
   if (knot_shape.size() != 2 || knot_shape[1] != dof)
     fail(path, std::string(ds::knots) + ": expected K x dof");
   v.knots_ = v.attach<double>(file, ds::knots, knot_shape, allow_mmap);
-  // The offsets index the knots: check them once so that no query can read out of bounds.
-  for (uint64_t e = 0; e < n; ++e) {
-    if (v.knot_offset_[e + 1] < v.knot_offset_[e] + 2 || v.knot_offset_[e + 1] > knot_shape[0]) {
-      fail(path,
-           std::string(ds::knot_offset) + ": edge " + std::to_string(e) + " has a bad knot range");
-    }
-  }
+  v.check_knot_ranges(knot_shape[0]);
   if (h5::exists(file, ds::perturbation)) {
     h5::Group g(H5Gopen2(file, ds::perturbation, H5P_DEFAULT));
     if (!g.valid()) fail(path, std::string(ds::perturbation) + ": cannot open group");
-    if (h5::read_attr_bool(path, g, "complete")) {
-      v.has_perturbation_ = true;
+    if (v.use_perturbation(h5::read_attr_bool(path, g, "complete"))) {
       v.perturbation_theta_ = h5::read_attr_f64(path, g, "theta");
       v.p_lazy_prop_ = v.attach<double>(file, ds::p_lazy_prop, {n}, allow_mmap);
       v.p_collision_ = v.attach<double>(file, ds::p_collision, {n}, allow_mmap);
-    } else {
-      v.warnings_.push_back(
-          "the perturbation analysis is incomplete (finish it with lazyboe-perturb): not used");
     }
   }
   return v;
+}
+
+BundleView BundleView::from_memory(std::shared_ptr<const Bundle> bundle, std::string name) {
+  if (!bundle) fail(name, "no bundle");
+  const Bundle& b = *bundle;
+  check_bundle(b, name);  // the sizes and offsets a file's shapes guarantee
+  require_complete(b.header, name);
+  BundleView v;
+  v.path_ = std::move(name);
+  v.header_ = b.header;
+  v.edges_ = b.size();
+  v.owned_.push_back(bundle);
+  v.q0_ = b.q0.data();
+  v.qf_ = b.qf.data();
+  v.duration_ = b.duration.data();
+  v.command_duration_ = b.command_duration.data();
+  v.knot_offset_ = b.knot_offset.data();
+  v.knots_ = b.knots.data();
+  v.check_knot_ranges(b.knots.size() / static_cast<size_t>(b.dof()));
+  const Perturbation& p = b.perturbation;
+  if (p.present && v.use_perturbation(p.complete)) {
+    v.perturbation_theta_ = p.theta;
+    v.p_lazy_prop_ = p.p_lazy_prop.data();
+    v.p_collision_ = p.p_collision.data();
+  }
+  return v;
+}
+
+// The offsets index the knots: check them once so that no query can read out of bounds.
+void BundleView::check_knot_ranges(uint64_t knot_rows) const {
+  for (uint64_t e = 0; e < edges_; ++e) {
+    if (knot_offset_[e + 1] < knot_offset_[e] + 2 || knot_offset_[e + 1] > knot_rows) {
+      fail(path_,
+           std::string(ds::knot_offset) + ": edge " + std::to_string(e) + " has a bad knot range");
+    }
+  }
+}
+
+// Only a finished analysis is used; an unfinished one is ignored with a warning.
+bool BundleView::use_perturbation(bool complete) {
+  if (!complete) {
+    warnings_.push_back(
+        "the perturbation analysis is incomplete (finish it with lazyboe-perturb): not used");
+    return false;
+  }
+  has_perturbation_ = true;
+  return true;
 }
 
 }  // namespace lazyboe

@@ -2,7 +2,8 @@
 // memory-mapped straight from the HDF5 file (contiguous datasets, at the offsets HDF5 reports),
 // so opening reads almost nothing, processes share one copy in the page cache, and a bundle
 // larger than RAM still works. A dataset that cannot be mapped (chunked, compressed, or not
-// aligned for its type) is read into memory instead, with a warning.
+// aligned for its type) is read into memory instead, with a warning. A view can also be made
+// of a bundle already in memory (tests, front ends that build their own), validated the same way.
 #pragma once
 
 #include <cstdint>
@@ -26,6 +27,9 @@ class BundleView {
   // Throws Error for a missing, corrupt or incomplete bundle. `allow_mmap = false` reads
   // every dataset into memory (the fallback path, also used to compare both).
   static BundleView open(const std::string& path, bool allow_mmap = true);
+  // A view into `bundle`'s arrays, which it keeps alive; `name` stands for the path in path()
+  // and in errors. Throws Error for an inconsistent (check_bundle) or incomplete bundle.
+  static BundleView from_memory(std::shared_ptr<const Bundle> bundle, std::string name);
 
   const std::string& path() const { return path_; }
   const BundleHeader& header() const { return header_; }
@@ -50,15 +54,18 @@ class BundleView {
   template <typename T>
   const T* attach(long file, const std::string& dataset, const std::vector<uint64_t>& dims,
                   bool allow_mmap);
+  // What both ways of making a view check and decide once the arrays are attached.
+  void check_knot_ranges(uint64_t knot_rows) const;
+  bool use_perturbation(bool complete);
 
   std::string path_;
   BundleHeader header_;
   size_t edges_ = 0;
   // The read-only mapping of the whole file (unmapped with the view) and datasets read into
-  // memory instead.
+  // memory instead (or the in-memory bundle viewed).
   std::unique_ptr<void, FileUnmap> map_;
   bool all_mapped_ = false;
-  std::vector<std::shared_ptr<void>> owned_;
+  std::vector<std::shared_ptr<const void>> owned_;
   std::vector<std::string> warnings_;
 
   const double* q0_ = nullptr;

@@ -1,0 +1,382 @@
+// Planning through the library only: the four planners (LazyBoE, BoE, RRT, SST) with plan() and
+// realize_path on one small dense bundle built and perturbed in memory (no tool runs).
+// Covered: every planner solves an easy problem; every returned trajectory passes the
+// independent re-validation of planning_fixture (and that re-validation catches broken ones);
+// the output is made of simulated edges only, LazyBoE does take edges lazily while the others
+// never do; a RolloutPool changes nothing but who simulates; LazyBoE refuses a bundle without
+// perturbation analysis; a start or goal outside the bundle's coverage fails at once with a
+// reason; a lazy chain without progress ends. test_query_cli runs the same through lazyboe-query.
+//
+// Run time matters: the bundle (2000 edges, p = 4) is built once per process, budgets are
+// 0.5-3 s.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <memory>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "cli_util.h"
+#include "lazyboe/bundle/bundle.h"
+#include "lazyboe/bundle/bundle_view.h"
+#include "lazyboe/common/error.h"
+#include "lazyboe/planning/neighbour_index.h"
+#include "lazyboe/planning/planners.h"
+#include "lazyboe/planning/problem.h"
+#include "lazyboe/sim/rollout_pool.h"
+#include "lazyboe/sim/simulator.h"
+#include "planning_fixture.h"
+
+namespace lazyboe::test {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// ------------------------------------------------------------------------------------------
+// The bundle: built once per process in memory, as the tools build it
+// ------------------------------------------------------------------------------------------
+
+struct Fixture : PlanningFixture {
+  Fixture() : Fixture(build_small_bundles()) {}
+  explicit Fixture(const SmallBundles& built)
+      : PlanningFixture(built.perturbed,
+                        BundleView::from_memory(built.perturbed, "the small bundle (in memory)")),
+        unperturbed(built.unperturbed) {}
+  std::shared_ptr<const Bundle> unperturbed;  // before the perturbation analysis
+};
+
+const Fixture& fixture() { return shared_fixture<Fixture>(); }
+
+// ------------------------------------------------------------------------------------------
+// Calling the planners (every test goes through these or calls plan() itself)
+// ------------------------------------------------------------------------------------------
+
+struct LibraryRun {
+  std::string planner;
+  PlanningProblem problem;
+  PlanResult result;
+  Trajectory trajectory;
+  bool realized = false;
+  std::string error;  // plan or realize_path threw
+};
+
+PlanningProblem library_problem(const PlanningFixture& f, const JointVectorRef& start,
+                                const JointVectorRef& goal, const std::string& planner,
+                                double budget) {
+  const BundleHeader& h = f.view.header();
+  PlanningProblem p;
+  p.start = start;
+  p.goal.kind = Goal::Kind::Joint;
+  p.goal.q = goal;
+  p.goal.tolerance = kTolerance;
+  p.params.planner = planner;
+  p.params.theta = f.view.has_perturbation() ? f.view.perturbation_theta() : h.design_theta;
+  p.params.budget = budget;
+  p.params.seed = 1;
+  p.params.sample_lower = joint(h.region_lower);
+  p.params.sample_upper = joint(h.region_upper);
+  p.params.command.min_duration = h.min_duration;
+  p.params.command.max_duration = h.max_duration;
+  p.params.command.knot_interval = h.knot_interval;
+  p.params.command.velocity_scale = h.velocity_scale;
+  p.params.command.limit_scale = h.limit_scale;
+  return p;
+}
+
+constexpr int kSampleEvery = 10;  // 0.01 s at 1 kHz, the tool's default
+
+// The easy problem a -> b with every planner, through the library, in parallel threads (one
+// workspace each; the simulator, bundle and index are shared read-only, as in the tool).
+const std::vector<LibraryRun>& library_runs() {
+  static const std::vector<LibraryRun> runs = [] {
+    const Fixture& f = fixture();
+    const PlanningContext context{f.sim, &f.view, &f.index};
+    std::vector<LibraryRun> out(kPlanners.size());
+    std::vector<std::thread> threads;
+    for (size_t i = 0; i < kPlanners.size(); ++i) {
+      threads.emplace_back([&, i] {
+        LibraryRun& r = out[i];
+        r.planner = kPlanners[i];
+        r.problem = library_problem(f, f.a, f.b, r.planner, easy_budget(r.planner));
+        SimulatorWorkspace ws(f.sim);
+        try {
+          r.result = plan(context, ws, r.problem);
+          if (r.result.success) {
+            r.trajectory = realize_path(f.sim, ws, r.problem.start, r.result.best_path,
+                                        r.problem.goal, kSampleEvery);
+            r.realized = true;
+          }
+        } catch (const std::exception& e) {
+          r.error = e.what();
+        }
+      });
+    }
+    for (std::thread& t : threads) t.join();
+    return out;
+  }();
+  return runs;
+}
+
+// ------------------------------------------------------------------------------------------
+// Every planner finds a path on an easy problem
+// ------------------------------------------------------------------------------------------
+
+TEST(Planners, EveryPlannerSolvesAnEasyProblem) {
+  const Fixture& f = fixture();
+  ASSERT_GE((f.a - f.b).norm(), 0.35);
+  ASSERT_LE((f.a - f.b).norm(), 0.45);
+  for (const LibraryRun& r : library_runs()) {
+    SCOPED_TRACE("library, " + r.planner);
+    EXPECT_TRUE(r.error.empty()) << r.error;
+    EXPECT_TRUE(r.result.success) << "failure: " << r.result.failure;
+    EXPECT_TRUE(r.realized);
+    EXPECT_GE(r.result.n_solutions, 1);
+    EXPECT_FALSE(r.result.best_path.empty());
+    EXPECT_GE(r.result.time_to_first_solution, 0.0);
+    EXPECT_LE(r.result.time_to_first_solution, r.problem.params.budget + 0.5);
+    EXPECT_TRUE(r.result.failure.empty()) << r.result.failure;
+  }
+}
+
+// ------------------------------------------------------------------------------------------
+// Every returned trajectory passes an independent re-validation
+// ------------------------------------------------------------------------------------------
+
+TEST(Planners, EveryReturnedTrajectoryPassesIndependentRevalidation) {
+  const Fixture& f = fixture();
+  int checked = 0;
+  for (const LibraryRun& r : library_runs()) {
+    if (!r.realized) continue;
+    SCOPED_TRACE("library, " + r.planner);
+    EXPECT_EQ(validate(f, r.trajectory, f.a, f.b, kTolerance, r.planner), "");
+    // One edges entry per path step, naming the step's bundle edge.
+    ASSERT_EQ(r.trajectory.edges.size(), r.result.best_path.size());
+    for (size_t k = 0; k < r.result.best_path.size(); ++k) {
+      EXPECT_EQ(r.trajectory.edges[k], r.result.best_path[k].bundle_edge) << "step " << k;
+    }
+    ++checked;
+  }
+  EXPECT_EQ(checked, static_cast<int>(kPlanners.size()))
+      << "every query should have returned a trajectory";
+}
+
+TEST(Planners, TheRevalidationCatchesBrokenTrajectories) {
+  const Fixture& f = fixture();
+  const LibraryRun* run = nullptr;
+  for (const LibraryRun& r : library_runs()) {
+    if (r.realized && r.planner == "boe") run = &r;
+  }
+  ASSERT_NE(run, nullptr) << "boe found no path";
+  const Trajectory& good = run->trajectory;
+  ASSERT_GE(good.t.size(), 4u);
+  const size_t mid = good.t.size() / 2;
+  auto problems = [&](const Trajectory& t) {
+    return validate(f, t, t.q[0], f.b, kTolerance, "boe");
+  };
+  SimulatorWorkspace ws(f.sim);
+  JointVector collide = good.q[mid];
+  while (check_state(f.sim, ws, collide) == RolloutStatus::Valid && collide[1] < f.robot.q_max[1])
+    collide[1] += 0.05;
+  ASSERT_NE(check_state(f.sim, ws, collide), RolloutStatus::Valid);
+
+  Trajectory t = good;
+  t.t[mid] = t.t[mid - 1];
+  EXPECT_TRUE(contains(problems(t), "strictly increasing")) << problems(t);
+  t = good;
+  t.dq[0][3] = 0.01;
+  EXPECT_TRUE(contains(problems(t), "first dq")) << problems(t);
+  t = good;
+  t.q[mid][2] += 0.2;
+  EXPECT_TRUE(contains(problems(t), "discontinuity")) << problems(t);
+  t = good;
+  t.q[mid] = collide;
+  EXPECT_TRUE(contains(problems(t), "check_state")) << problems(t);
+  t = good;
+  t.dq[mid][0] = f.robot.dq_max[0] * 1.01;
+  EXPECT_TRUE(contains(problems(t), "velocity limit")) << problems(t);
+  t = good;
+  t.q.back() = f.a;
+  EXPECT_TRUE(contains(problems(t), "from the goal")) << problems(t);
+  t = good;
+  t.edges.back() = static_cast<int64_t>(f.view.size());
+  EXPECT_TRUE(contains(problems(t), "not a bundle edge")) << problems(t);
+  EXPECT_TRUE(contains(validate(f, good, f.b, f.b, kTolerance, "boe"), "query start"));
+  // An end state that is not the simulated one (a stored, lazy end would differ like this).
+  t = good;
+  t.q.back()[6] += 1e-6;
+  EXPECT_TRUE(contains(resimulate(f, f.a, bundle_commands(f, good.edges), t), "differs"));
+  t = good;
+  t.t.back() += 0.01;
+  EXPECT_TRUE(contains(resimulate(f, f.a, bundle_commands(f, good.edges), t), "duration"));
+  EXPECT_EQ(resimulate(f, f.a, bundle_commands(f, good.edges), good), "");
+}
+
+// ------------------------------------------------------------------------------------------
+// No lazy edge in any output
+// ------------------------------------------------------------------------------------------
+
+TEST(Planners, OutputsAreMadeOfSimulatedEdgesOnly) {
+  const Fixture& f = fixture();
+  bool lazy_somewhere = false;
+  for (const LibraryRun& r : library_runs()) {
+    if (!r.realized) continue;
+    SCOPED_TRACE("library, " + r.planner);
+    // The path's commands, simulated one after the other from the start, end exactly where
+    // the trajectory ends; for the bundle planners the edge ids name the same commands.
+    std::vector<CommandProfile> commands;
+    for (const PathStep& s : r.result.best_path) {
+      commands.push_back({s.knots.data(), static_cast<int>(s.knots.size() / f.robot.dof),
+                          f.robot.dof, s.command_duration});
+    }
+    EXPECT_EQ(resimulate(f, f.a, commands, r.trajectory), "");
+    if (is_bundle_planner(r.planner)) {
+      EXPECT_EQ(resimulate(f, f.a, bundle_commands(f, r.trajectory.edges), r.trajectory), "");
+    }
+    // A lazy node's cost is an estimate from stored states; a path of simulated edges costs
+    // exactly what re-simulating it measures.
+    EXPECT_NEAR(r.result.best_cost, r.trajectory.cost, 1e-9);
+    if (r.planner == "lazyboe") lazy_somewhere |= r.result.counters.lazy_edges > 0;
+    if (r.planner != "lazyboe") {
+      EXPECT_EQ(r.result.counters.lazy_edges, 0u);
+    }
+  }
+  EXPECT_TRUE(lazy_somewhere)
+      << "lazyboe never took an edge lazily (counters.lazy_edges = 0 everywhere)";
+}
+
+// ------------------------------------------------------------------------------------------
+// Parallel rollouts
+// ------------------------------------------------------------------------------------------
+
+TEST(Planners, ARolloutPoolChangesNothingButWhoSimulates) {
+  const Fixture& f = fixture();
+  const PlanningContext context{f.sim, &f.view, &f.index};
+  for (const std::string planner : {"lazyboe", "boe"}) {
+    SCOPED_TRACE(planner);
+    PlanningProblem p = library_problem(f, f.a, f.c, planner, 10);
+    p.params.stop_at_first = true;
+    p.params.seed = 7;
+    SimulatorWorkspace ws(f.sim);
+    const PlanResult alone = plan(context, ws, p);
+    RolloutPool pool(f.sim, 3);
+    const PlanResult pooled = plan(context, ws, p, &pool);
+    ASSERT_TRUE(alone.success) << alone.failure;
+    EXPECT_GT(pool.rollouts(), 0u) << "the search did not use the pool";
+    // Unused rollouts are only those of the last wave, when the search stops.
+    EXPECT_LE(pool.rollouts(), pooled.counters.simulations + kWavePerThread * pool.threads() - 1);
+    EXPECT_EQ(pooled.success, alone.success);
+    EXPECT_EQ(pooled.n_solutions, alone.n_solutions);
+    EXPECT_EQ(pooled.best_cost, alone.best_cost);
+    EXPECT_EQ(pooled.counters.nodes, alone.counters.nodes);
+    EXPECT_EQ(pooled.counters.simulations, alone.counters.simulations);
+    EXPECT_EQ(pooled.counters.lazy_edges, alone.counters.lazy_edges);
+    EXPECT_EQ(pooled.counters.collision_checks, alone.counters.collision_checks);
+    ASSERT_EQ(pooled.best_path.size(), alone.best_path.size());
+    for (size_t s = 0; s < alone.best_path.size(); ++s)
+      EXPECT_EQ(pooled.best_path[s].bundle_edge, alone.best_path[s].bundle_edge) << "step " << s;
+  }
+}
+
+// ------------------------------------------------------------------------------------------
+// A bundle without perturbation analysis
+// ------------------------------------------------------------------------------------------
+
+// LazyBoE needs the analysis; boe on the same bundle works (test_query_cli).
+TEST(Planners, LazyBoEOnABundleWithoutPerturbationIsRefused) {
+  const Fixture& f = fixture();
+  const BundleView plain = BundleView::from_memory(f.unperturbed, "the unperturbed bundle");
+  EXPECT_FALSE(plain.has_perturbation());
+  // And through the library.
+  const EdgeStartIndex plain_index(plain);
+  const PlanningContext context{f.sim, &plain, &plain_index};
+  SimulatorWorkspace ws(f.sim);
+  try {
+    plan(context, ws, library_problem(f, f.a, f.b, "lazyboe", 1));
+    ADD_FAILURE() << "lazyboe planned on a bundle without perturbation analysis";
+  } catch (const Error& e) {
+    EXPECT_TRUE(contains(e.what(), "lazyboe-perturb")) << e.what();
+  }
+}
+
+// ------------------------------------------------------------------------------------------
+// Start or goal outside the bundle's coverage
+// ------------------------------------------------------------------------------------------
+
+TEST(Planners, StartOrGoalOutsideTheCoverageFailsWithAReason) {
+  const Fixture& f = fixture();
+  const double theta = f.view.perturbation_theta();
+  const JointVector far_start = far_state(f, f.a, {1.5, -1.5, 2.0, -2.0, 1.2, -1.2}, theta, false);
+  ASSERT_EQ(far_start.size(), 7) << "no collision-free state far from the bundle's starts";
+  const JointVector far_goal =
+      far_state(f, f.b, {2.2, -2.2, 2.5, -2.5, 1.8, -1.8}, theta + kTolerance, true);
+  ASSERT_EQ(far_goal.size(), 7) << "no collision-free state far from the bundle's ends";
+
+  // Library: a clear failure at once, not a timeout.
+  const PlanningContext context{f.sim, &f.view, &f.index};
+  SimulatorWorkspace ws(f.sim);
+  for (const std::string planner : {"lazyboe", "boe"}) {
+    for (bool start_is_far : {true, false}) {
+      SCOPED_TRACE(planner + std::string(start_is_far ? ", far start" : ", far goal"));
+      const auto t0 = Clock::now();
+      const PlanResult r = plan(context, ws,
+                                library_problem(f, start_is_far ? far_start : f.a,
+                                                start_is_far ? f.b : far_goal, planner, 5));
+      const double seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+      EXPECT_FALSE(r.success);
+      EXPECT_LT(seconds, 1.0) << "ran into its 5 s budget instead of failing at once";
+      EXPECT_TRUE(contains(r.failure, "theta")) << "failure: " << r.failure;
+      EXPECT_TRUE(contains(r.failure, "bundle")) << "failure: " << r.failure;
+      EXPECT_TRUE(contains(r.failure, start_is_far ? "start" : "goal")) << "failure: " << r.failure;
+      EXPECT_FALSE(contains(r.failure, "time budget")) << "failure: " << r.failure;
+    }
+  }
+}
+
+TEST(Planners, ALazyChainWithoutProgressEnds) {
+  const Fixture& f = fixture();
+  const int n = f.data.dof();
+  const size_t k = 0;
+  Bundle one;
+  one.header = f.data.header;
+  auto rows = [&](const std::vector<double>& v, size_t from, size_t to) {
+    return std::vector<double>(v.begin() + from * n, v.begin() + to * n);
+  };
+  one.q0 = rows(f.data.q0, k, k + 1);
+  one.qf = one.q0;  // the stored end is the start
+  one.duration = {f.data.duration[k]};
+  one.command_duration = {f.data.command_duration[k]};
+  one.attempt = {f.data.attempt[k]};
+  one.knot_offset = {0, f.data.knot_offset[k + 1] - f.data.knot_offset[k]};
+  one.knots = rows(f.data.knots, f.data.knot_offset[k], f.data.knot_offset[k + 1]);
+  one.sample_offset = {0, 0};
+  one.header.valid = 1;
+  one.header.target_edges = 1;
+  Perturbation& p = one.perturbation;
+  p = f.data.perturbation;
+  p.done = {p.perturbations};
+  p.valid = {p.perturbations};
+  p.lazy = {p.perturbations};
+  p.collision = {0};
+  p.max_error = {0.0};
+  p.p_lazy_prop = {1.0};  // always taken lazily
+  p.p_collision = {0.0};
+  const BundleView view =
+      BundleView::from_memory(std::make_shared<const Bundle>(one), "one self-loop edge");
+  const EdgeStartIndex index(view);
+  const PlanningContext context{f.sim, &view, &index};
+
+  const JointVector start = f.edge_start(k);
+  JointVector goal = start;
+  goal[n - 1] += 0.5;  // beyond the tolerance, within theta + tolerance of the stored end
+  PlanningProblem problem = library_problem(f, start, goal, "lazyboe", 0.5);
+  SimulatorWorkspace ws(f.sim);
+  const PlanResult r = plan(context, ws, problem);
+  EXPECT_GT(r.counters.lazy_edges, 0u);
+  EXPECT_LE(r.counters.lazy_edges, r.counters.simulations + 2)
+      << "lazy edges " << r.counters.lazy_edges << ", simulations " << r.counters.simulations
+      << ": a lazy chain went on without simulating";
+}
+
+}  // namespace
+}  // namespace lazyboe::test
