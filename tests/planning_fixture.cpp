@@ -10,6 +10,7 @@
 #include "lazyboe/bundle/builder.h"
 #include "lazyboe/bundle/perturbation.h"
 #include "lazyboe/common/error.h"
+#include "lazyboe/planning/registry.h"
 
 namespace lazyboe::test {
 
@@ -155,7 +156,8 @@ JointVector PlanningFixture::edge_start(size_t e) const {
 }
 
 bool is_bundle_planner(const std::string& planner) {
-  return planner == "lazyboe" || planner == "boe";
+  const PlannerInfo* info = find_planner(planner);
+  return info && info->needs.bundle;
 }
 
 double easy_budget(const std::string& planner) { return is_bundle_planner(planner) ? 1.5 : 3.0; }

@@ -22,8 +22,9 @@
 #include "lazyboe/bundle/bundle_view.h"
 #include "lazyboe/common/error.h"
 #include "lazyboe/planning/neighbour_index.h"
-#include "lazyboe/planning/planners.h"
 #include "lazyboe/planning/problem.h"
+#include "lazyboe/planning/registry.h"
+#include "lazyboe/planning/rollout_scheduler.h"
 #include "lazyboe/sim/rollout_pool.h"
 #include "lazyboe/sim/simulator.h"
 #include "planning_fixture.h"
@@ -61,27 +62,33 @@ struct LibraryRun {
   std::string error;  // plan or realize_path threw
 };
 
-PlanningProblem library_problem(const PlanningFixture& f, const JointVectorRef& start,
-                                const JointVectorRef& goal, const std::string& planner,
+PlanningProblem library_problem(const JointVectorRef& start, const JointVectorRef& goal,
                                 double budget) {
-  const BundleHeader& h = f.view.header();
   PlanningProblem p;
   p.start = start;
   p.goal.kind = Goal::Kind::Joint;
   p.goal.q = goal;
   p.goal.tolerance = kTolerance;
-  p.params.planner = planner;
-  p.params.theta = f.view.has_perturbation() ? f.view.perturbation_theta() : h.design_theta;
-  p.params.budget = budget;
-  p.params.seed = 1;
-  p.params.sample_lower = joint(h.region_lower);
-  p.params.sample_upper = joint(h.region_upper);
-  p.params.command.min_duration = h.min_duration;
-  p.params.command.max_duration = h.max_duration;
-  p.params.command.knot_interval = h.knot_interval;
-  p.params.command.velocity_scale = h.velocity_scale;
-  p.params.command.limit_scale = h.limit_scale;
+  p.termination.budget = budget;
+  p.seed = 1;
   return p;
+}
+
+// The context a planning session makes for a bundle: theta, sampling box and command family
+// from its header.
+PlanningContext library_context(const PlanningFixture& f, const BundleView& view,
+                                const EdgeStartIndex& index) {
+  const BundleHeader& h = view.header();
+  PlanningContext c{f.sim, &view, &index};
+  c.theta = view.has_perturbation() ? view.perturbation_theta() : h.design_theta;
+  c.sample_lower = joint(h.region_lower);
+  c.sample_upper = joint(h.region_upper);
+  c.command.min_duration = h.min_duration;
+  c.command.max_duration = h.max_duration;
+  c.command.knot_interval = h.knot_interval;
+  c.command.velocity_scale = h.velocity_scale;
+  c.command.limit_scale = h.limit_scale;
+  return c;
 }
 
 constexpr int kSampleEvery = 10;  // 0.01 s at 1 kHz, the tool's default
@@ -91,17 +98,17 @@ constexpr int kSampleEvery = 10;  // 0.01 s at 1 kHz, the tool's default
 const std::vector<LibraryRun>& library_runs() {
   static const std::vector<LibraryRun> runs = [] {
     const Fixture& f = fixture();
-    const PlanningContext context{f.sim, &f.view, &f.index};
+    const PlanningContext context = library_context(f, f.view, f.index);
     std::vector<LibraryRun> out(kPlanners.size());
     std::vector<std::thread> threads;
     for (size_t i = 0; i < kPlanners.size(); ++i) {
       threads.emplace_back([&, i] {
         LibraryRun& r = out[i];
         r.planner = kPlanners[i];
-        r.problem = library_problem(f, f.a, f.b, r.planner, easy_budget(r.planner));
+        r.problem = library_problem(f.a, f.b, easy_budget(r.planner));
         SimulatorWorkspace ws(f.sim);
         try {
-          r.result = plan(context, ws, r.problem);
+          r.result = plan(context, ws, r.planner, {}, r.problem);
           if (r.result.success) {
             r.trajectory = realize_path(f.sim, ws, r.problem.start, r.result.best_path,
                                         r.problem.goal, kSampleEvery);
@@ -134,7 +141,7 @@ TEST(Planners, EveryPlannerSolvesAnEasyProblem) {
     EXPECT_GE(r.result.n_solutions, 1);
     EXPECT_FALSE(r.result.best_path.empty());
     EXPECT_GE(r.result.time_to_first_solution, 0.0);
-    EXPECT_LE(r.result.time_to_first_solution, r.problem.params.budget + 0.5);
+    EXPECT_LE(r.result.time_to_first_solution, r.problem.termination.budget + 0.5);
     EXPECT_TRUE(r.result.failure.empty()) << r.result.failure;
   }
 }
@@ -160,6 +167,55 @@ TEST(Planners, EveryReturnedTrajectoryPassesIndependentRevalidation) {
   EXPECT_EQ(checked, static_cast<int>(kPlanners.size()))
       << "every query should have returned a trajectory";
 }
+
+// Every planner in the registry (a new one is tested without another line here) solves the
+// easy problem a -> b through make_planner, setup and solve, and its path passes realize_path
+// and the independent re-validation. Planners not built in (OMPL's, without OMPL) are skipped.
+class EveryRegisteredPlanner : public ::testing::TestWithParam<std::string> {};
+
+std::vector<std::string> registered_names() {
+  std::vector<std::string> names;
+  for (const PlannerInfo& info : planner_registry()) names.push_back(info.name);
+  return names;
+}
+
+TEST_P(EveryRegisteredPlanner, SolvesAnEasyProblemWithAValidPath) {
+  const std::string name = GetParam();
+  const PlannerInfo& info = planner_info(name);
+  std::string why;
+  if (!info.available(&why)) GTEST_SKIP() << name << ": " << why;
+  const Fixture& f = fixture();
+  const PlanningContext context = library_context(f, f.view, f.index);
+  PlanningProblem problem = library_problem(f.a, f.b, 5);
+  problem.termination.stop_at_first = true;
+  const std::unique_ptr<Planner> planner = make_planner(name, {});
+  planner->setup(context);
+  SimulatorWorkspace ws(f.sim);
+  const PlanResult r = planner->solve(problem, ws);
+  ASSERT_TRUE(r.success) << name << ": " << r.failure;
+  EXPECT_GE(r.n_solutions, 1);
+  EXPECT_GT(r.counters.simulations, 0u);
+  const Trajectory t =
+      realize_path(f.sim, ws, problem.start, r.best_path, problem.goal, kSampleEvery);
+  EXPECT_NEAR(t.cost, r.best_cost, 1e-9 * (1 + r.best_cost));
+  EXPECT_EQ(validate(f, t, f.a, f.b, kTolerance, name), "");
+  for (const PathStep& s : r.best_path) EXPECT_EQ(s.bundle_edge >= 0, info.needs.bundle);
+  planner->clear();
+  // Solving again after clear() gives the same answer (a planner keeps nothing between solves).
+  const PlanResult again = planner->solve(problem, ws);
+  if (!info.needs.ompl) {  // OMPL's process-wide generator has moved on
+    EXPECT_EQ(again.best_cost, r.best_cost);
+    EXPECT_EQ(again.counters.simulations, r.counters.simulations);
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Registry, EveryRegisteredPlanner, ::testing::ValuesIn(registered_names()),
+                         [](const ::testing::TestParamInfo<std::string>& p) {
+                           std::string id = p.param;
+                           for (char& c : id)
+                             c = std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
+                           return id;
+                         });
 
 TEST(Planners, TheRevalidationCatchesBrokenTrajectories) {
   const Fixture& f = fixture();
@@ -251,16 +307,16 @@ TEST(Planners, OutputsAreMadeOfSimulatedEdgesOnly) {
 
 TEST(Planners, ARolloutPoolChangesNothingButWhoSimulates) {
   const Fixture& f = fixture();
-  const PlanningContext context{f.sim, &f.view, &f.index};
+  const PlanningContext context = library_context(f, f.view, f.index);
   for (const std::string planner : {"lazyboe", "boe"}) {
     SCOPED_TRACE(planner);
-    PlanningProblem p = library_problem(f, f.a, f.c, planner, 10);
-    p.params.stop_at_first = true;
-    p.params.seed = 7;
+    PlanningProblem p = library_problem(f.a, f.c, 10);
+    p.termination.stop_at_first = true;
+    p.seed = 7;
     SimulatorWorkspace ws(f.sim);
-    const PlanResult alone = plan(context, ws, p);
+    const PlanResult alone = plan(context, ws, planner, {}, p);
     RolloutPool pool(f.sim, 3);
-    const PlanResult pooled = plan(context, ws, p, &pool);
+    const PlanResult pooled = plan(context, ws, planner, {}, p, &pool);
     ASSERT_TRUE(alone.success) << alone.failure;
     EXPECT_GT(pool.rollouts(), 0u) << "the search did not use the pool";
     // Unused rollouts are only those of the last wave, when the search stops.
@@ -289,10 +345,10 @@ TEST(Planners, LazyBoEOnABundleWithoutPerturbationIsRefused) {
   EXPECT_FALSE(plain.has_perturbation());
   // And through the library.
   const EdgeStartIndex plain_index(plain);
-  const PlanningContext context{f.sim, &plain, &plain_index};
+  const PlanningContext context = library_context(f, plain, plain_index);
   SimulatorWorkspace ws(f.sim);
   try {
-    plan(context, ws, library_problem(f, f.a, f.b, "lazyboe", 1));
+    plan(context, ws, "lazyboe", {}, library_problem(f.a, f.b, 1));
     ADD_FAILURE() << "lazyboe planned on a bundle without perturbation analysis";
   } catch (const Error& e) {
     EXPECT_TRUE(contains(e.what(), "lazyboe-perturb")) << e.what();
@@ -313,15 +369,15 @@ TEST(Planners, StartOrGoalOutsideTheCoverageFailsWithAReason) {
   ASSERT_EQ(far_goal.size(), 7) << "no collision-free state far from the bundle's ends";
 
   // Library: a clear failure at once, not a timeout.
-  const PlanningContext context{f.sim, &f.view, &f.index};
+  const PlanningContext context = library_context(f, f.view, f.index);
   SimulatorWorkspace ws(f.sim);
   for (const std::string planner : {"lazyboe", "boe"}) {
     for (bool start_is_far : {true, false}) {
       SCOPED_TRACE(planner + std::string(start_is_far ? ", far start" : ", far goal"));
       const auto t0 = Clock::now();
-      const PlanResult r = plan(context, ws,
-                                library_problem(f, start_is_far ? far_start : f.a,
-                                                start_is_far ? f.b : far_goal, planner, 5));
+      const PlanResult r =
+          plan(context, ws, planner, {},
+               library_problem(start_is_far ? far_start : f.a, start_is_far ? f.b : far_goal, 5));
       const double seconds = std::chrono::duration<double>(Clock::now() - t0).count();
       EXPECT_FALSE(r.success);
       EXPECT_LT(seconds, 1.0) << "ran into its 5 s budget instead of failing at once";
@@ -364,14 +420,14 @@ TEST(Planners, ALazyChainWithoutProgressEnds) {
   const BundleView view =
       BundleView::from_memory(std::make_shared<const Bundle>(one), "one self-loop edge");
   const EdgeStartIndex index(view);
-  const PlanningContext context{f.sim, &view, &index};
+  const PlanningContext context = library_context(f, view, index);
 
   const JointVector start = f.edge_start(k);
   JointVector goal = start;
   goal[n - 1] += 0.5;  // beyond the tolerance, within theta + tolerance of the stored end
-  PlanningProblem problem = library_problem(f, start, goal, "lazyboe", 0.5);
+  PlanningProblem problem = library_problem(start, goal, 0.5);
   SimulatorWorkspace ws(f.sim);
-  const PlanResult r = plan(context, ws, problem);
+  const PlanResult r = plan(context, ws, "lazyboe", {}, problem);
   EXPECT_GT(r.counters.lazy_edges, 0u);
   EXPECT_LE(r.counters.lazy_edges, r.counters.simulations + 2)
       << "lazy edges " << r.counters.lazy_edges << ", simulations " << r.counters.simulations

@@ -44,18 +44,18 @@ int main(int argc, char** argv) {
     lazyboe::validate_problem(session.sim, ws, problem);  // limits, collision, reach
 
     const std::string planner = argc > 4 ? argv[4] : "lazyboe";
-    const lazyboe::PlanResult result =
-        lazyboe::plan(session.context(), ws, planner, {}, problem);
+    const lazyboe::PlanResult result = lazyboe::plan(session.context(), ws, planner, {}, problem);
     if (!result.success) {
       std::printf("%s: no solution: %s\n", planner.c_str(), result.failure.c_str());
       return 1;
     }
     // Every returned path is simulated again from the exact start with every check.
-    const lazyboe::Trajectory t = lazyboe::realize_path(session.sim, ws, problem.start,
-                                                        result.best_path, problem.goal, 10);
-    std::printf("%s: solved in %.3f s, %zu edges, %llu simulations; trajectory %.2f s, cost %.3f rad\n",
-                planner.c_str(), result.time_to_first_solution, result.best_path.size(),
-                static_cast<unsigned long long>(result.counters.simulations), t.duration, t.cost);
+    const lazyboe::Trajectory t =
+        lazyboe::realize_path(session.sim, ws, problem.start, result.best_path, problem.goal, 10);
+    std::printf(
+        "%s: solved in %.3f s, %zu edges, %llu simulations; trajectory %.2f s, cost %.3f rad\n",
+        planner.c_str(), result.time_to_first_solution, result.best_path.size(),
+        static_cast<unsigned long long>(result.counters.simulations), t.duration, t.cost);
     return 0;
   } catch (const lazyboe::Error& e) {
     std::fprintf(stderr, "plan_one_query: error: %s\n", e.what());

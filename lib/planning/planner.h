@@ -19,6 +19,10 @@ namespace lazyboe {
 // and its neighbour index; what sampling planners need (the state sampling box and command
 // family; by default the bundle's); the default neighbourhood radius.
 struct PlanningContext {
+  explicit PlanningContext(const Simulator& simulator, const BundleView* edge_bundle = nullptr,
+                           const EdgeStartIndex* edge_index = nullptr)
+      : sim(simulator), bundle(edge_bundle), index(edge_index) {}
+
   const Simulator& sim;
   const BundleView* bundle = nullptr;  // null for planners that do not use one
   const EdgeStartIndex* index = nullptr;
