@@ -2,8 +2,9 @@
 # (scripts/install-deps.sh, Debian packages) and build first.
 BUILD_DIR ?= build
 JOBS ?= $(shell nproc)
+PREFIX ?= /usr/local
 
-.PHONY: all deps build test demo bench format clean
+.PHONY: all deps build test demo bench install format clean
 
 all: build
 
@@ -19,6 +20,9 @@ test: build
 
 demo: build
 	@scripts/demo.sh $(BUILD_DIR)
+
+install: build
+	cmake --install $(BUILD_DIR) --prefix $(PREFIX)
 
 bench: build
 	$(BUILD_DIR)/bin/bench_robot
