@@ -68,8 +68,6 @@ Trajectory realize_path(const Simulator& sim, SimulatorWorkspace& ws, const Join
                         const std::vector<PathStep>& steps, const Goal& goal, int sample_every) {
   const int n = sim.robot.dof;
   Trajectory traj;
-  Simulator sampled(sim.robot, sim.collision, sim.options);
-  sampled.options.sample_every = sample_every;
   JointVector q = start;
   double t0 = 0;
   std::vector<float> sq, sdq;
@@ -79,7 +77,7 @@ Trajectory realize_path(const Simulator& sim, SimulatorWorkspace& ws, const Join
                                  s.command_duration};
     sq.clear();
     sdq.clear();
-    const RolloutResult r = simulate(sampled, ws, q, profile, {&sq, &sdq});
+    const RolloutResult r = simulate(sim, ws, q, profile, {&sq, &sdq, sample_every});
     if (!r.valid()) {
       fail("path",
            "step " + std::to_string(k) + " fails re-validation: " + rollout_status_name(r.status));
@@ -88,7 +86,7 @@ Trajectory realize_path(const Simulator& sim, SimulatorWorkspace& ws, const Join
     for (size_t i = (k == 0 ? 0 : 1); i < rows; ++i) {  // a step starts where the last ended
       const bool last = i + 1 == rows;
       traj.t.push_back(t0 +
-                       (last ? r.duration : static_cast<double>(i * sample_every) * sampled.dt));
+                       (last ? r.duration : static_cast<double>(i * sample_every) * sim.dt));
       // The start and each step's end are exact; samples in between are stored as float32
       // by the simulator (to about 1e-7 rad).
       JointVector qi(n), dqi(n);

@@ -122,6 +122,7 @@ RolloutResult simulate(const Simulator& sim, SimulatorWorkspace& ws, const Joint
   const int n = robot.dof;
   const double dt = sim.dt, h = dt / sim.options.substeps;
   const double margin = sim.collision.margin;
+  const int sample_every = samples.every > 0 ? samples.every : sim.options.sample_every;
   RobotData& rd = ws.robot;
 
   RolloutResult result;
@@ -176,7 +177,7 @@ RolloutResult simulate(const Simulator& sim, SimulatorWorkspace& ws, const Joint
           const RolloutStatus c = collision_status(sim, ws, q, result.collision_checks);
           if (c != RolloutStatus::Valid) return finish(c, tick);
         }
-        if (samples.q && (sim.options.sample_every <= 0 || tick % sim.options.sample_every != 0)) {
+        if (samples.q && (sample_every <= 0 || tick % sample_every != 0)) {
           push_sample(samples, q, dq);
         }
         return finish(RolloutStatus::Valid, tick);
@@ -236,7 +237,7 @@ RolloutResult simulate(const Simulator& sim, SimulatorWorkspace& ws, const Joint
     } else {
       moved += step;
     }
-    if (sim.options.sample_every > 0 && (tick + 1) % sim.options.sample_every == 0) {
+    if (sample_every > 0 && (tick + 1) % sample_every == 0) {
       push_sample(samples, q, dq);
     }
   }

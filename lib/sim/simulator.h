@@ -71,10 +71,12 @@ struct RolloutResult {
   bool valid() const { return status == RolloutStatus::Valid; }
 };
 
-// Optional output of a rollout: states every `sample_every` ticks, plus the final state.
+// Optional output of a rollout: states every `every` control ticks (0: the simulator's
+// options.sample_every), plus the final state.
 struct TrajectorySamples {
   std::vector<float>* q = nullptr;
   std::vector<float>* dq = nullptr;
+  int every = 0;
 };
 
 // Simulates from rest at q0. Stops at the first violation. Allocates nothing when the sample
