@@ -134,6 +134,7 @@ PlanResult plan(const PlanningContext& context, SimulatorWorkspace& ws, const st
                 const ParameterValues& values, const PlanningProblem& problem, RolloutPool* pool) {
   const std::unique_ptr<Planner> p = make_planner(planner, values);
   p->setup(context);
+  validate_problem(context.sim, ws, problem);
   return p->solve(problem, ws, pool);
 }
 

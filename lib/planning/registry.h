@@ -66,7 +66,7 @@ std::unique_ptr<Planner> make_planner(const std::string& name, const ParameterVa
 // range and description.
 std::string planner_list_text();
 
-// One query from start to finish: make_planner, setup, solve.
+// One query from start to finish: make_planner, setup, validate_problem, solve.
 PlanResult plan(const PlanningContext& context, SimulatorWorkspace& ws, const std::string& planner,
                 const ParameterValues& values, const PlanningProblem& problem,
                 RolloutPool* pool = nullptr);
