@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "lazyboe/bundle/bundle.h"
 #include "test_util.h"
 
 namespace lazyboe::test {
@@ -61,5 +62,8 @@ template <typename T>
   }
   return ::testing::AssertionSuccess();
 }
+
+// The edge count and every per-edge array of the two bundles are identical, bit for bit.
+void expect_same_edge_arrays(const Bundle& a, const Bundle& b);
 
 }  // namespace lazyboe::test

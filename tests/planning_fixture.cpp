@@ -333,4 +333,13 @@ JointVector far_state(const PlanningFixture& f, const JointVectorRef& base,
   return JointVector();
 }
 
+JointVector far_start_state(const PlanningFixture& f) {
+  return far_state(f, f.a, {1.5, -1.5, 2.0, -2.0, 1.2, -1.2}, f.view.perturbation_theta(), false);
+}
+
+JointVector far_goal_state(const PlanningFixture& f) {
+  return far_state(f, f.b, {2.2, -2.2, 2.5, -2.5, 1.8, -1.8},
+                   f.view.perturbation_theta() + kTolerance, true);
+}
+
 }  // namespace lazyboe::test

@@ -124,4 +124,9 @@ double nearest_distance(const PlanningFixture& f, const JointVectorRef& q, bool 
 JointVector far_state(const PlanningFixture& f, const JointVectorRef& base,
                       const std::vector<double>& offsets, double clearance, bool ends);
 
+// States beyond the coverage of the fixture's bundle, from the easy pair: a start farther than
+// theta from every edge start, a goal farther than theta + tolerance from every edge end.
+JointVector far_start_state(const PlanningFixture& f);
+JointVector far_goal_state(const PlanningFixture& f);
+
 }  // namespace lazyboe::test

@@ -156,7 +156,6 @@ bool wait_for_checkpoint(Background& b, const std::string& path, ino_t before,
   return false;
 }
 
-
 // ------------------------------------------------------------------------------------------
 // Comparing bundles
 // ------------------------------------------------------------------------------------------
@@ -166,17 +165,7 @@ bool same_double(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0
 // Every edge dataset of the two bundles is identical, and so is the header (all but
 // wall_seconds and tool_version).
 void expect_same_edges(const Bundle& a, const Bundle& b) {
-  EXPECT_EQ(a.size(), b.size());
-  EXPECT_TRUE(same_array("q0", a.q0, b.q0));
-  EXPECT_TRUE(same_array("qf", a.qf, b.qf));
-  EXPECT_TRUE(same_array("duration", a.duration, b.duration));
-  EXPECT_TRUE(same_array("command_duration", a.command_duration, b.command_duration));
-  EXPECT_TRUE(same_array("attempt", a.attempt, b.attempt));
-  EXPECT_TRUE(same_array("knot_offset", a.knot_offset, b.knot_offset));
-  EXPECT_TRUE(same_array("knots", a.knots, b.knots));
-  EXPECT_TRUE(same_array("sample_offset", a.sample_offset, b.sample_offset));
-  EXPECT_TRUE(same_array("sample_q", a.sample_q, b.sample_q));
-  EXPECT_TRUE(same_array("sample_dq", a.sample_dq, b.sample_dq));
+  expect_same_edge_arrays(a, b);
   const BundleHeader &x = a.header, &y = b.header;
   EXPECT_EQ(x.complete, y.complete);
   EXPECT_EQ(x.robot_config, y.robot_config);

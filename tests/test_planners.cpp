@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "cli_util.h"
+#include "lazyboe/bundle/builder.h"
 #include "lazyboe/bundle/bundle.h"
 #include "lazyboe/bundle/bundle_view.h"
 #include "lazyboe/common/error.h"
@@ -78,16 +79,12 @@ PlanningProblem library_problem(const JointVectorRef& start, const JointVectorRe
 // from its header.
 PlanningContext library_context(const PlanningFixture& f, const BundleView& view,
                                 const EdgeStartIndex& index) {
-  const BundleHeader& h = view.header();
+  const BuildSettings settings = settings_from_header(view.header());
   PlanningContext c{f.sim, &view, &index};
-  c.theta = view.has_perturbation() ? view.perturbation_theta() : h.design_theta;
-  c.sample_lower = joint(h.region_lower);
-  c.sample_upper = joint(h.region_upper);
-  c.command.min_duration = h.min_duration;
-  c.command.max_duration = h.max_duration;
-  c.command.knot_interval = h.knot_interval;
-  c.command.velocity_scale = h.velocity_scale;
-  c.command.limit_scale = h.limit_scale;
+  c.theta = view.has_perturbation() ? view.perturbation_theta() : view.header().design_theta;
+  c.sample_lower = settings.region_lower;
+  c.sample_upper = settings.region_upper;
+  c.command = settings.command;
   return c;
 }
 
@@ -361,11 +358,8 @@ TEST(Planners, LazyBoEOnABundleWithoutPerturbationIsRefused) {
 
 TEST(Planners, StartOrGoalOutsideTheCoverageFailsWithAReason) {
   const Fixture& f = fixture();
-  const double theta = f.view.perturbation_theta();
-  const JointVector far_start = far_state(f, f.a, {1.5, -1.5, 2.0, -2.0, 1.2, -1.2}, theta, false);
+  const JointVector far_start = far_start_state(f), far_goal = far_goal_state(f);
   ASSERT_EQ(far_start.size(), 7) << "no collision-free state far from the bundle's starts";
-  const JointVector far_goal =
-      far_state(f, f.b, {2.2, -2.2, 2.5, -2.5, 1.8, -1.8}, theta + kTolerance, true);
   ASSERT_EQ(far_goal.size(), 7) << "no collision-free state far from the bundle's ends";
 
   // Library: a clear failure at once, not a timeout.

@@ -243,16 +243,7 @@ void expect_same_bundle(const Bundle& a, const Bundle& b) {
   EXPECT_EQ(h.rejected, g.rejected);
   EXPECT_EQ(h.start_resamples, g.start_resamples);
   EXPECT_EQ(a.size(), static_cast<size_t>(kEdges));
-  EXPECT_TRUE(same_array("q0", a.q0, b.q0));
-  EXPECT_TRUE(same_array("qf", a.qf, b.qf));
-  EXPECT_TRUE(same_array("duration", a.duration, b.duration));
-  EXPECT_TRUE(same_array("command_duration", a.command_duration, b.command_duration));
-  EXPECT_TRUE(same_array("attempt", a.attempt, b.attempt));
-  EXPECT_TRUE(same_array("knot_offset", a.knot_offset, b.knot_offset));
-  EXPECT_TRUE(same_array("knots", a.knots, b.knots));
-  EXPECT_TRUE(same_array("sample_offset", a.sample_offset, b.sample_offset));
-  EXPECT_TRUE(same_array("sample_q", a.sample_q, b.sample_q));
-  EXPECT_TRUE(same_array("sample_dq", a.sample_dq, b.sample_dq));
+  expect_same_edge_arrays(a, b);
   const Perturbation& p = a.perturbation;
   const Perturbation& q = b.perturbation;
   EXPECT_EQ(p.present, q.present);
@@ -841,11 +832,8 @@ TEST(QueryCli, CsvTrajectoriesHaveTheInlineRows) {
 
 TEST(QueryCli, StartOrGoalOutsideTheCoverageFailsWithAReason) {
   const Fixture& f = fixture();
-  const double theta = f.view.perturbation_theta();
-  const JointVector far_start = far_state(f, f.a, {1.5, -1.5, 2.0, -2.0, 1.2, -1.2}, theta, false);
+  const JointVector far_start = far_start_state(f), far_goal = far_goal_state(f);
   ASSERT_EQ(far_start.size(), 7) << "no collision-free state far from the bundle's starts";
-  const JointVector far_goal =
-      far_state(f, f.b, {2.2, -2.2, 2.5, -2.5, 1.8, -1.8}, theta + kTolerance, true);
   ASSERT_EQ(far_goal.size(), 7) << "no collision-free state far from the bundle's ends";
 
   // Tool: the reason in the result.
