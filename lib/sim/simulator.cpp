@@ -147,8 +147,11 @@ struct Stages {
 
 // One control period with the torque held: `substeps` steps (of h) of RK4 or semi-implicit Euler.
 // The first step reuses the dynamics terms of this tick's state; ddq is its acceleration.
-inline void integrate_period(const Simulator& sim, RobotData& rd, const JointVector& tau, double h,
-                             JointVector& q, JointVector& dq, JointVector& ddq, Stages& k) {
+// Both helpers are inlined into simulate (they run every tick), as before they were split out.
+[[gnu::always_inline]] inline void integrate_period(const Simulator& sim, RobotData& rd,
+                                                    const JointVector& tau, double h,
+                                                    JointVector& q, JointVector& dq,
+                                                    JointVector& ddq, Stages& k) {
   const RobotModel& robot = sim.robot;
   for (int sub = 0; sub < sim.options.substeps; ++sub) {
     if (sim.options.integrator == Integrator::SemiImplicitEuler) {
@@ -177,9 +180,11 @@ inline void integrate_period(const Simulator& sim, RobotData& rd, const JointVec
 // Collision checks spaced so that no point moves more than the margin between two: `moved`
 // bounds the path length of any point since the last check; a tick that moves too far is
 // checked in between as well (at `between`, scratch).
-inline RolloutStatus check_motion(const Simulator& sim, SimulatorWorkspace& ws,
-                                  const JointVector& q_prev, const JointVector& q, double& moved,
-                                  JointVector& between, int& checks) {
+[[gnu::always_inline]] inline RolloutStatus check_motion(const Simulator& sim,
+                                                         SimulatorWorkspace& ws,
+                                                         const JointVector& q_prev,
+                                                         const JointVector& q, double& moved,
+                                                         JointVector& between, int& checks) {
   const double margin = sim.collision.margin;
   const double step = sim.lever_arm.dot((q - q_prev).cwiseAbs());
   if (!(moved + step > margin)) {
