@@ -31,7 +31,7 @@ std::string str(const JointVectorRef& q) {
 
 SimulationOptions options_of(const BundleHeader& h) {
   SimulationOptions o;
-  o.integrator = h.integrator == "rk4" ? Integrator::RK4 : Integrator::SemiImplicitEuler;
+  o.integrator = parse_integrator(h.integrator, "integrator");
   o.substeps = h.substeps;
   o.sample_every = 0;
   return o;

@@ -121,7 +121,7 @@ TEST(Collision, NearTouchingRespectsTheMargin) {
   probe.set(kReady);
   const int s = shape_index(probe.model, "link7_a");
   ASSERT_GE(s, 0);
-  const fcl::Transform3d& t = probe.cd.transform[s];
+  const Eigen::Isometry3d& t = probe.cd.transform[s];
   const double capsule_radius = 0.04, sphere_radius = 0.01;
   const double margin = robot.collision_margin;
   ASSERT_GT(margin, 0.002);

@@ -4,6 +4,7 @@
 // closed-form model, and no heap allocation in the hot paths.
 #include <gtest/gtest.h>
 
+#include <Eigen/Eigenvalues>
 #include <atomic>
 #include <cmath>
 #include <cstdlib>

@@ -12,6 +12,7 @@
 #include <thread>
 
 #include "lazyboe/bench/report.h"
+#include "lazyboe/common/atomic_file.h"
 #include "lazyboe/planning/ompl/ompl_planners.h"
 #include "lazyboe/planning/planning_session.h"
 #include "tool_main.h"
@@ -54,12 +55,9 @@ nlohmann::json study_parameters(const std::string& bundle, const std::string& pl
 }
 
 void write_text(const fs::path& path, const std::string& text) {
-  const fs::path tmp = path.string() + ".tmp";
-  {
-    std::ofstream out(tmp);
-    if (!out || !(out << text) || !out.flush()) fail(path.string(), "cannot write");
-  }
-  fs::rename(tmp, path);
+  AtomicFile file(path.string());
+  file.stream() << text;
+  file.commit();
 }
 
 // Runs the plotting script when python3 with matplotlib is there; says so when it is not.
@@ -81,224 +79,286 @@ void draw_figures(const fs::path& out_dir, bool quiet) {
   }
 }
 
+// The command line.
+struct BenchOptions {
+  std::string bundle_path, problems_file, planners = "all", out_dir, robot_path, env_path;
+  int problems = 25, repeats = 1, jobs = 1;
+  double budget = 60, tolerance = 0;
+  uint64_t seed = 1;
+  bool resume = false, force = false, no_figures = false, no_mmap = false, quiet = false;
+};
+
+void add_options(CLI::App& app, BenchOptions& o) {
+  app.add_option("--bundle", o.bundle_path, "Bundle file (HDF5) with its perturbation analysis")
+      ->required();
+  app.add_option("--out", o.out_dir, "Directory for problems.jsonl, runs.csv, summary.md, figures")
+      ->required();
+  app.add_option("--problems", o.problems, "Random problems to draw in the bundle's region")
+      ->capture_default_str()
+      ->check(whole_number(false));
+  app.add_option("--problems-file", o.problems_file,
+                 "Read the problems from a JSON Lines query file instead (e.g. an earlier "
+                 "study's problems.jsonl)");
+  app.add_option("--budget", o.budget, "Wall-clock seconds per run")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  app.add_option("--seed", o.seed, "Study seed (problems and per-run planner seeds)")
+      ->capture_default_str();
+  app.add_option("--planners", o.planners,
+                 "all, or a comma-separated list of lazyboe, boe, rrt, sst (= sst-0.5x, sst-1x, "
+                 "sst-2x), ompl-rrt, ompl-sst, ompl-kpiece")
+      ->capture_default_str();
+  app.add_option("--repeats", o.repeats, "Runs per planner and problem, with different seeds")
+      ->capture_default_str()
+      ->check(whole_number(false));
+  app.add_option("--jobs", o.jobs, "Runs in parallel (at most one per core: budgets are wall time)")
+      ->capture_default_str()
+      ->check(whole_number(false));
+  app.add_option("--tolerance", o.tolerance,
+                 "Radius of the joint-space goal region of drawn problems, rad (default: the "
+                 "bundle's theta)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--robot", o.robot_path, "Robot config (default: the bundle's)");
+  app.add_option("--env", o.env_path, "Environment (default: the bundle's)");
+  app.add_flag("--resume", o.resume, "Continue an interrupted study in --out");
+  app.add_flag("--force", o.force, "Overwrite the results of an earlier study in --out");
+  app.add_flag("--no-figures", o.no_figures, "Do not draw the PNG figures");
+  app.add_flag("--no-mmap", o.no_mmap, "Read the bundle into memory instead of mapping it");
+  app.add_flag("--quiet", o.quiet, "No progress output");
+}
+
+// The files of a study in --out.
+struct StudyPaths {
+  explicit StudyPaths(const fs::path& out)
+      : dir(out),
+        problems(out / "problems.jsonl"),
+        runs(out / "runs.csv"),
+        partial(out / "runs.partial.csv"),
+        study(out / "study.json"),
+        summary(out / "summary.md") {}
+  fs::path dir, problems, runs, partial, study, summary;
+};
+
+// Refuses --resume without a study, or overwriting one without --force; warns about more jobs
+// than cores.
+void check_out_dir(const BenchOptions& o, const StudyPaths& paths) {
+  if (o.resume && o.force) fail("--resume", "cannot be combined with --force");
+  if (o.resume && !fs::exists(paths.study)) {
+    fail(paths.study.string(), "no study to resume (run without --resume first)");
+  }
+  if (!o.resume && !o.force && (fs::exists(paths.runs) || fs::exists(paths.partial))) {
+    fail(paths.dir.string(),
+         "holds an earlier study; use --resume to continue it or --force to "
+         "replace it");
+  }
+  const unsigned cores = std::thread::hardware_concurrency();  // 0 when unknown
+  if (cores > 0 && o.jobs > static_cast<int>(cores)) {
+    std::fprintf(stderr,
+                 "lazyboe-bench: warning: %d jobs on %u cores: budgets are wall time, so runs "
+                 "sharing a core get less planning time\n",
+                 o.jobs, std::thread::hardware_concurrency());
+  }
+}
+
+// A resumed study must have been run with the same parameters.
+void check_same_study(const fs::path& study_path, const nlohmann::json& parameters) {
+  std::ifstream in(study_path);
+  nlohmann::json saved;
+  try {
+    in >> saved;
+  } catch (const nlohmann::json::exception&) {
+    fail(study_path.string(), "not valid JSON");
+  }
+  if (saved != parameters) {
+    fail(study_path.string(), "the study there was run with other parameters (" + saved.dump() +
+                                  "); rerun with the same ones to resume");
+  }
+}
+
+// The study's problems: those of the study resumed, read from --problems-file, or drawn; a new
+// study writes them and its parameters to --out. `source` says where they came from.
+std::vector<BenchProblem> study_problems(const BenchOptions& o, const StudyPaths& paths,
+                                         const PlanningSession& session,
+                                         const nlohmann::json& parameters, std::string& source) {
+  const PlanningContext defaults = session.context();
+  SimulatorWorkspace ws(session.sim);
+  const QueryDefaults query_defaults;
+  if (o.resume) {
+    source = "resumed from " + paths.problems.string();
+    return read_problems(paths.problems.string(), session.sim, ws, query_defaults);
+  }
+  if (o.force) {  // study.json first: its absence marks the directory as not resumable
+    for (const fs::path& p : {paths.study, paths.runs, paths.partial, paths.summary}) fs::remove(p);
+  }
+  std::vector<BenchProblem> problems;
+  if (!o.problems_file.empty()) {
+    problems = read_problems(o.problems_file, session.sim, ws, query_defaults);
+    source = "read from " + o.problems_file;
+  } else {
+    const double radius = o.tolerance > 0 ? o.tolerance : defaults.theta;
+    problems = sample_problems(session.sim, ws, defaults.sample_lower, defaults.sample_upper,
+                               o.problems, radius, o.seed);
+    source = "drawn with seed " + std::to_string(o.seed) +
+             " in the bundle's region, goal tolerance " + std::to_string(radius) + " rad";
+  }
+  write_problems(paths.problems.string(), session.scene.robot, problems);
+  write_text(paths.study, parameters.dump(2) + "\n");
+  return problems;
+}
+
+// Runs already done: the partial file of an interrupted study, or the runs.csv of a finished
+// one (resuming it only writes its summary and figures again).
+std::vector<RunRecord> runs_done(const BenchOptions& o, const StudyPaths& paths,
+                                 const std::vector<std::string>& problem_ids) {
+  if (o.resume && fs::exists(paths.partial))
+    return read_runs_csv(paths.partial.string(), problem_ids);
+  if (o.resume && fs::exists(paths.runs)) return read_runs_csv(paths.runs.string(), problem_ids);
+  return {};
+}
+
+// The runs still to do: problem by problem, every planner in turn, so that a partial study is
+// balanced across planners.
+std::vector<StudyTask> tasks_to_do(const std::vector<PlannerSpec>& specs, int problems, int repeats,
+                                   const std::vector<RunRecord>& done) {
+  std::map<std::tuple<std::string, int, int>, bool> have;
+  for (const RunRecord& r : done) have[{r.planner, r.problem, r.repeat}] = true;
+  std::vector<StudyTask> tasks;
+  for (int rep = 0; rep < repeats; ++rep) {
+    for (int p = 0; p < problems; ++p) {
+      for (int s = 0; s < static_cast<int>(specs.size()); ++s) {
+        if (specs[s].available && !have.count({specs[s].name, p, rep}))
+          tasks.push_back({s, p, rep});
+      }
+    }
+  }
+  return tasks;
+}
+
+void print_run(const RunRecord& r, const std::string& problem_id, size_t finished, size_t total) {
+  if (r.success) {
+    std::fprintf(stderr, "[%zu/%zu] %-11s %s repeat %d: solved, first after %.3f s, cost %.2f\n",
+                 finished, total, r.planner.c_str(), problem_id.c_str(), r.repeat,
+                 r.time_to_first_solution, r.best_cost);
+  } else {
+    std::fprintf(stderr, "[%zu/%zu] %-11s %s repeat %d: no solution (%s)\n", finished, total,
+                 r.planner.c_str(), problem_id.c_str(), r.repeat, r.failure.c_str());
+  }
+}
+
+// Writes runs.csv (sorted by repeat, problem, planner order) and summary.md.
+void write_results(const BenchOptions& o, const StudyPaths& paths, const StudyInfo& info,
+                   const std::vector<PlannerSpec>& specs, std::vector<RunRecord>& runs,
+                   const std::vector<std::string>& problem_ids) {
+  std::map<std::string, int> order;
+  for (size_t s = 0; s < specs.size(); ++s) order[specs[s].name] = static_cast<int>(s);
+  std::sort(runs.begin(), runs.end(), [&](const RunRecord& a, const RunRecord& b) {
+    return std::make_tuple(a.repeat, a.problem, order[a.planner]) <
+           std::make_tuple(b.repeat, b.problem, order[b.planner]);
+  });
+  write_runs_csv(paths.runs.string(), runs, problem_ids);
+  write_text(paths.summary, summary_markdown(info, specs, runs));
+  fs::remove(paths.partial);
+  if (!o.no_figures) draw_figures(paths.dir, o.quiet);
+  if (!o.quiet) {
+    std::fprintf(stderr, "lazyboe-bench: wrote %s, %s and %s\n", paths.problems.c_str(),
+                 paths.runs.c_str(), paths.summary.c_str());
+  }
+}
+
+StudyInfo study_info(const BenchOptions& o, const PlanningSession& session, int problems,
+                     const std::string& problems_source, const std::string& command_line) {
+  StudyInfo info;
+  info.bundle = o.bundle_path;
+  info.edges = session.bundle.size();
+  info.robot = session.scene.robot.config_path;
+  info.environment = session.scene.env.path;
+  info.problems = problems;
+  info.problems_source = problems_source;
+  info.repeats = o.repeats;
+  info.jobs = o.jobs;
+  info.budget = o.budget;
+  info.seed = o.seed;
+  info.machine = machine_description();
+  info.command_line = command_line;
+  return info;
+}
+
+int run(const BenchOptions& o, const std::string& command_line) {
+  const StudyPaths paths{fs::path(o.out_dir)};
+  check_out_dir(o, paths);
+  const nlohmann::json parameters =
+      study_parameters(o.bundle_path, o.planners, o.budget, o.repeats, o.seed, o.problems,
+                       o.problems_file, o.tolerance);
+  if (o.resume) check_same_study(paths.study, parameters);  // before anything is loaded
+
+  planner_specs(o.planners);  // names checked before the bundle is loaded
+  const PlanningSession session(o.bundle_path, !o.no_mmap, o.robot_path, o.env_path);
+  if (!o.quiet) {
+    std::fprintf(stderr, "lazyboe-bench: %s: %zu edges loaded in %.3f s\n", o.bundle_path.c_str(),
+                 session.bundle.size(), session.load_seconds);
+  }
+  const std::vector<PlannerSpec> specs = planner_specs(o.planners);
+  for (const PlannerSpec& s : specs) {
+    if (!s.available)
+      std::fprintf(stderr, "lazyboe-bench: skipping %s: %s\n", s.name.c_str(),
+                   s.unavailable_reason.c_str());
+  }
+  if (ompl_available()) seed_ompl(o.seed);
+
+  fs::create_directories(paths.dir);
+  std::string problems_source;
+  const std::vector<BenchProblem> problems =
+      study_problems(o, paths, session, parameters, problems_source);
+  std::vector<std::string> problem_ids;
+  for (const BenchProblem& p : problems) problem_ids.push_back(p.id);
+
+  std::vector<RunRecord> runs = runs_done(o, paths, problem_ids);
+  const std::vector<StudyTask> tasks =
+      tasks_to_do(specs, static_cast<int>(problems.size()), o.repeats, runs);
+  if (!o.quiet) {
+    std::fprintf(stderr,
+                 "lazyboe-bench: %zu problems, %zu planners, %d repeat(s): %zu runs to do%s, "
+                 "at most %.0f s each\n",
+                 problems.size(), specs.size(), o.repeats, tasks.size(),
+                 runs.empty() ? "" : (" (" + std::to_string(runs.size()) + " done)").c_str(),
+                 o.budget);
+  }
+
+  install_stop_handlers();
+  PartialRunsFile partial(paths.partial.string());
+  StudyControl control;
+  control.jobs = o.jobs;
+  control.stop_requested = stop_requested;
+  control.on_run = [&](const RunRecord& r, size_t finished, size_t total) {
+    partial.append(r, problem_ids[r.problem]);
+    if (!o.quiet) print_run(r, problem_ids[r.problem], finished, total);
+  };
+  const std::vector<RunRecord> fresh =
+      run_study(session.context(), specs, problems, tasks, o.budget, o.seed, control);
+  runs.insert(runs.end(), fresh.begin(), fresh.end());
+  if (fresh.size() < tasks.size()) {  // stopped before every run was done
+    std::fprintf(stderr,
+                 "lazyboe-bench: interrupted: %zu runs saved in %s; continue with --resume\n",
+                 runs.size(), paths.partial.c_str());
+    return 130;
+  }
+  const StudyInfo info =
+      study_info(o, session, static_cast<int>(problems.size()), problems_source, command_line);
+  write_results(o, paths, info, specs, runs, problem_ids);
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{
       "Benchmark study: every planner on the same random problems with the same budget (the "
       "paper's evaluation), side by side with OMPL's control planners."};
-  std::string bundle_path, problems_file, planners = "all", out_dir, robot_path, env_path;
-  int problems = 25, repeats = 1, jobs = 1;
-  double budget = 60, tolerance = 0;
-  uint64_t seed = 1;
-  bool resume = false, force = false, no_figures = false, no_mmap = false, quiet = false;
-  app.add_option("--bundle", bundle_path, "Bundle file (HDF5) with its perturbation analysis")
-      ->required();
-  app.add_option("--out", out_dir, "Directory for problems.jsonl, runs.csv, summary.md, figures")
-      ->required();
-  app.add_option("--problems", problems, "Random problems to draw in the bundle's region")
-      ->capture_default_str()
-      ->check(whole_number(false));
-  app.add_option("--problems-file", problems_file,
-                 "Read the problems from a JSON Lines query file instead (e.g. an earlier "
-                 "study's problems.jsonl)");
-  app.add_option("--budget", budget, "Wall-clock seconds per run")
-      ->capture_default_str()
-      ->check(CLI::PositiveNumber);
-  app.add_option("--seed", seed, "Study seed (problems and per-run planner seeds)")
-      ->capture_default_str();
-  app.add_option("--planners", planners,
-                 "all, or a comma-separated list of lazyboe, boe, rrt, sst (= sst-0.5x, sst-1x, "
-                 "sst-2x), ompl-rrt, ompl-sst, ompl-kpiece")
-      ->capture_default_str();
-  app.add_option("--repeats", repeats, "Runs per planner and problem, with different seeds")
-      ->capture_default_str()
-      ->check(whole_number(false));
-  app.add_option("--jobs", jobs, "Runs in parallel (at most one per core: budgets are wall time)")
-      ->capture_default_str()
-      ->check(whole_number(false));
-  app.add_option("--tolerance", tolerance,
-                 "Radius of the joint-space goal region of drawn problems, rad (default: the "
-                 "bundle's theta)")
-      ->check(CLI::PositiveNumber);
-  app.add_option("--robot", robot_path, "Robot config (default: the bundle's)");
-  app.add_option("--env", env_path, "Environment (default: the bundle's)");
-  app.add_flag("--resume", resume, "Continue an interrupted study in --out");
-  app.add_flag("--force", force, "Overwrite the results of an earlier study in --out");
-  app.add_flag("--no-figures", no_figures, "Do not draw the PNG figures");
-  app.add_flag("--no-mmap", no_mmap, "Read the bundle into memory instead of mapping it");
-  app.add_flag("--quiet", quiet, "No progress output");
+  BenchOptions options;
+  add_options(app, options);
   one_line_cli_errors(app, "lazyboe-bench");
   CLI11_PARSE(app, argc, argv);
-
-  return run_tool("lazyboe-bench", [&]() -> int {
-    const fs::path dir(out_dir);
-    const fs::path problems_path = dir / "problems.jsonl", runs_path = dir / "runs.csv",
-                   partial_path = dir / "runs.partial.csv", study_path = dir / "study.json";
-    if (resume && force) fail("--resume", "cannot be combined with --force");
-    if (resume && !fs::exists(study_path)) {
-      fail(study_path.string(), "no study to resume (run without --resume first)");
-    }
-    if (!resume && !force && (fs::exists(runs_path) || fs::exists(partial_path))) {
-      fail(dir.string(),
-           "holds an earlier study; use --resume to continue it or --force to "
-           "replace it");
-    }
-    const unsigned cores = std::thread::hardware_concurrency();  // 0 when unknown
-    if (cores > 0 && jobs > static_cast<int>(cores)) {
-      std::fprintf(stderr,
-                   "lazyboe-bench: warning: %d jobs on %u cores: budgets are wall time, so runs "
-                   "sharing a core get less planning time\n",
-                   jobs, std::thread::hardware_concurrency());
-    }
-
-    const nlohmann::json parameters = study_parameters(bundle_path, planners, budget, repeats, seed,
-                                                       problems, problems_file, tolerance);
-    if (resume) {  // before anything is loaded: a mismatch is refused at once
-      std::ifstream in(study_path);
-      nlohmann::json saved;
-      try {
-        in >> saved;
-      } catch (const nlohmann::json::exception&) {
-        fail(study_path.string(), "not valid JSON");
-      }
-      if (saved != parameters) {
-        fail(study_path.string(), "the study there was run with other parameters (" + saved.dump() +
-                                      "); rerun with the same ones to resume");
-      }
-    }
-
-    planner_specs(planners);  // names checked before the bundle is loaded
-    const PlanningSession session(bundle_path, !no_mmap, robot_path, env_path);
-    if (!quiet) {
-      std::fprintf(stderr, "lazyboe-bench: %s: %zu edges loaded in %.3f s\n", bundle_path.c_str(),
-                   session.bundle.size(), session.load_seconds);
-    }
-    const std::vector<PlannerSpec> specs = planner_specs(planners);
-    for (const PlannerSpec& s : specs) {
-      if (!s.available)
-        std::fprintf(stderr, "lazyboe-bench: skipping %s: %s\n", s.name.c_str(),
-                     s.unavailable_reason.c_str());
-    }
-    if (ompl_available()) seed_ompl(seed);
-
-    fs::create_directories(dir);
-    SimulatorWorkspace ws(session.sim);
-    std::vector<BenchProblem> study_problems;
-    std::string problems_source;
-    QueryDefaults query_defaults;
-    if (resume) {
-      study_problems = read_problems(problems_path.string(), session.sim, ws, query_defaults);
-      problems_source = "resumed from " + problems_path.string();
-    } else {
-      if (force) {  // study.json first: its absence marks the directory as not resumable
-        for (const fs::path& p : {study_path, runs_path, partial_path, dir / "summary.md"})
-          fs::remove(p);
-      }
-      if (!problems_file.empty()) {
-        study_problems = read_problems(problems_file, session.sim, ws, query_defaults);
-        problems_source = "read from " + problems_file;
-      } else {
-        const PlanningContext defaults = session.context();
-        const double radius = tolerance > 0 ? tolerance : defaults.theta;
-        study_problems = sample_problems(session.sim, ws, defaults.sample_lower,
-                                         defaults.sample_upper, problems, radius, seed);
-        problems_source = "drawn with seed " + std::to_string(seed) +
-                          " in the bundle's region, goal tolerance " + std::to_string(radius) +
-                          " rad";
-      }
-      write_problems(problems_path.string(), session.scene.robot, study_problems);
-      write_text(study_path, parameters.dump(2) + "\n");
-    }
-    std::vector<std::string> problem_ids;
-    for (const BenchProblem& p : study_problems) problem_ids.push_back(p.id);
-
-    std::vector<RunRecord> runs;
-    // Runs already done: the partial file of an interrupted study, or the runs.csv of a
-    // finished one (resuming it only writes its summary and figures again).
-    if (resume && fs::exists(partial_path)) {
-      runs = read_runs_csv(partial_path.string(), problem_ids);
-    } else if (resume && fs::exists(runs_path)) {
-      runs = read_runs_csv(runs_path.string(), problem_ids);
-    }
-    std::map<std::tuple<std::string, int, int>, bool> have;
-    for (const RunRecord& r : runs) have[{r.planner, r.problem, r.repeat}] = true;
-    // The rest: problem by problem, every planner in turn, so that a partial study is balanced
-    // across planners.
-    std::vector<StudyTask> tasks;
-    for (int rep = 0; rep < repeats; ++rep) {
-      for (int p = 0; p < static_cast<int>(study_problems.size()); ++p) {
-        for (int s = 0; s < static_cast<int>(specs.size()); ++s) {
-          if (specs[s].available && !have.count({specs[s].name, p, rep}))
-            tasks.push_back({s, p, rep});
-        }
-      }
-    }
-    if (!quiet) {
-      std::fprintf(stderr,
-                   "lazyboe-bench: %zu problems, %zu planners, %d repeat(s): %zu runs to do%s, "
-                   "at most %.0f s each\n",
-                   study_problems.size(), specs.size(), repeats, tasks.size(),
-                   runs.empty() ? "" : (" (" + std::to_string(runs.size()) + " done)").c_str(),
-                   budget);
-    }
-
-    install_stop_handlers();
-    PartialRunsFile partial(partial_path.string());
-    StudyControl control;
-    control.jobs = jobs;
-    control.stop_requested = stop_requested;
-    control.on_run = [&](const RunRecord& r, size_t finished, size_t total) {
-      partial.append(r, problem_ids[r.problem]);
-      if (quiet) return;
-      if (r.success) {
-        std::fprintf(stderr,
-                     "[%zu/%zu] %-11s %s repeat %d: solved, first after %.3f s, cost %.2f\n",
-                     finished, total, r.planner.c_str(), problem_ids[r.problem].c_str(), r.repeat,
-                     r.time_to_first_solution, r.best_cost);
-      } else {
-        std::fprintf(stderr, "[%zu/%zu] %-11s %s repeat %d: no solution (%s)\n", finished, total,
-                     r.planner.c_str(), problem_ids[r.problem].c_str(), r.repeat,
-                     r.failure.c_str());
-      }
-    };
-    const std::vector<RunRecord> fresh =
-        run_study(session.context(), specs, study_problems, tasks, budget, seed, control);
-    runs.insert(runs.end(), fresh.begin(), fresh.end());
-    if (fresh.size() < tasks.size()) {  // stopped before every run was done
-      std::fprintf(stderr,
-                   "lazyboe-bench: interrupted: %zu runs saved in %s; continue with --resume\n",
-                   runs.size(), partial_path.c_str());
-      return 130;
-    }
-
-    std::map<std::string, int> order;
-    for (size_t s = 0; s < specs.size(); ++s) order[specs[s].name] = static_cast<int>(s);
-    std::sort(runs.begin(), runs.end(), [&](const RunRecord& a, const RunRecord& b) {
-      return std::make_tuple(a.repeat, a.problem, order[a.planner]) <
-             std::make_tuple(b.repeat, b.problem, order[b.planner]);
-    });
-    write_runs_csv(runs_path.string(), runs, problem_ids);
-    StudyInfo info;
-    info.bundle = bundle_path;
-    info.edges = session.bundle.size();
-    info.robot = session.scene.robot.config_path;
-    info.environment = session.scene.env.path;
-    info.problems = static_cast<int>(study_problems.size());
-    info.problems_source = problems_source;
-    info.repeats = repeats;
-    info.jobs = jobs;
-    info.budget = budget;
-    info.seed = seed;
-    info.machine = machine_description();
-    for (int k = 0; k < argc; ++k) info.command_line += (k ? " " : "") + std::string(argv[k]);
-    write_text(dir / "summary.md", summary_markdown(info, specs, runs));
-    fs::remove(partial_path);
-    if (!no_figures) draw_figures(dir, quiet);
-    if (!quiet) {
-      std::fprintf(stderr, "lazyboe-bench: wrote %s, %s and %s\n", problems_path.c_str(),
-                   runs_path.c_str(), (dir / "summary.md").c_str());
-    }
-    return 0;
-  });
+  std::string command_line;
+  for (int k = 0; k < argc; ++k) command_line += (k ? " " : "") + std::string(argv[k]);
+  return run_tool("lazyboe-bench", [&]() -> int { return run(options, command_line); });
 }

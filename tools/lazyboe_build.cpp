@@ -71,40 +71,36 @@ void parse_region(const std::string& text, const RobotModel& robot, JointVector&
     fail("--region", "expected " + std::to_string(n) + " lo:hi pairs, got " + std::to_string(i));
 }
 
-Integrator parse_integrator(const std::string& name) {
-  if (name == "euler") return Integrator::SemiImplicitEuler;
-  if (name == "rk4") return Integrator::RK4;
-  fail("--integrator", "expected euler or rk4, got '" + name + "'");
-}
-
 void print_summary(const Bundle& b) {
   std::fprintf(stderr, "lazyboe-build: %zu edges (%s)\n", b.size(),
                b.header.complete ? "complete" : "incomplete");
   print_build_summary(b.header, stderr);
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  CLI::App app{"Generate an edge bundle: valid random rollouts of the robot's dynamics, in HDF5."};
+// The command line. Settings go straight into `settings`, except those that need the robot.
+struct BuildOptions {
   std::string robot_path = default_robot_path(), env_path = default_environment_path();
   std::string out_path, inspect_path, region = "default", integrator = "euler";
-  BuildSettings s;
+  BuildSettings settings;
   BuildControl control;
   double sample_interval = 0.05;
   bool resume = false, force = false;
-  app.add_option("--robot", robot_path, "Robot config (JSON)")->capture_default_str();
-  app.add_option("--env", env_path, "Environment (JSON)")->capture_default_str();
-  app.add_option("--out", out_path, "Bundle file to write (HDF5)");
+};
+
+void add_options(CLI::App& app, BuildOptions& o) {
+  BuildSettings& s = o.settings;
+  app.add_option("--robot", o.robot_path, "Robot config (JSON)")->capture_default_str();
+  app.add_option("--env", o.env_path, "Environment (JSON)")->capture_default_str();
+  app.add_option("--out", o.out_path, "Bundle file to write (HDF5)");
   app.add_option("--edges", s.edges, "Valid edges to generate")
       ->capture_default_str()
       ->check(whole_number(false));
   app.add_option("--seed", s.seed, "Random seed")->capture_default_str()->check(whole_number(true));
-  app.add_option("--threads", control.threads, "Threads (0: all cores)")
+  app.add_option("--threads", o.control.threads, "Threads (0: all cores)")
       ->capture_default_str()
       ->check(whole_number(true));
   app.add_option(
-         "--region", region,
+         "--region", o.region,
          "Start-state box: default (robot config), limits, a JSON file, or lo:hi,... per joint")
       ->capture_default_str();
   app.add_option("--min-duration", s.command.min_duration, "Shortest velocity command, s")
@@ -119,136 +115,165 @@ int main(int argc, char** argv) {
   app.add_option("--limit-scale", s.command.limit_scale,
                  "Commanded acceleration and jerk up to this fraction of the limits")
       ->capture_default_str();
-  app.add_option("--integrator", integrator, "euler (semi-implicit) or rk4")->capture_default_str();
+  app.add_option("--integrator", o.integrator, "euler (semi-implicit) or rk4")
+      ->capture_default_str();
   app.add_option("--substeps", s.simulation.substeps, "Integration steps per control period")
       ->capture_default_str();
-  app.add_option("--sample-interval", sample_interval, "Stored trajectory spacing, s (0: none)")
+  app.add_option("--sample-interval", o.sample_interval, "Stored trajectory spacing, s (0: none)")
       ->capture_default_str();
   app.add_option("--theta", s.design_theta, "Neighbourhood radius the bundle is designed for (rad)")
       ->capture_default_str();
-  app.add_option("--checkpoint-seconds", control.checkpoint_seconds,
+  app.add_option("--checkpoint-seconds", o.control.checkpoint_seconds,
                  "Least time between checkpoints")
       ->capture_default_str()
       ->check(number_at_least_zero());
-  app.add_flag("--resume", resume, "Continue an interrupted build in --out (to --edges)");
-  app.add_flag("--force", force, "Overwrite an existing --out");
-  app.add_flag("--quiet", control.quiet, "No progress output");
-  app.add_option("--inspect", inspect_path,
+  app.add_flag("--resume", o.resume, "Continue an interrupted build in --out (to --edges)");
+  app.add_flag("--force", o.force, "Overwrite an existing --out");
+  app.add_flag("--quiet", o.control.quiet, "No progress output");
+  app.add_option("--inspect", o.inspect_path,
                  "Print the header and statistics of a bundle, then exit");
+}
+
+// Checks the options that need no file, in the order of their messages' precedence.
+void check_options(const BuildOptions& o) {
+  const BuildSettings& s = o.settings;
+  if (o.out_path.empty()) fail("--out", "required (the bundle file to write)");
+  if (o.resume && o.force) fail("--resume", "cannot be combined with --force");
+  if (s.edges == 0) fail("--edges", "must be > 0");
+  if (!(s.command.min_duration > 0)) fail("--min-duration", "must be > 0");
+  if (!(s.command.max_duration >= s.command.min_duration)) {
+    fail("--max-duration", "must be >= --min-duration");
+  }
+  if (!(s.command.knot_interval > 0)) fail("--knot-interval", "must be > 0");
+  if (!(s.command.velocity_scale > 0 && s.command.velocity_scale <= 1))
+    fail("--velocity-scale", "must be in (0, 1]");
+  if (!(s.command.limit_scale > 0 && s.command.limit_scale <= 1))
+    fail("--limit-scale", "must be in (0, 1]");
+  if (s.simulation.substeps < 1) fail("--substeps", "must be >= 1");
+  if (!(s.design_theta > 0)) fail("--theta", "must be > 0");
+  if (o.control.threads < 0) fail("--threads", "must be >= 0");
+  if (!(o.sample_interval >= 0)) fail("--sample-interval", "must be >= 0");
+}
+
+// A resumed build takes every setting from the file; options given now must agree with it.
+void take_settings_from(const CLI::App& app, const BundleHeader& h, BuildOptions& o) {
+  BuildSettings& s = o.settings;
+  if (!app.count("--robot")) o.robot_path = h.robot_config;
+  if (!app.count("--env")) o.env_path = h.env_file;
+  const BuildSettings from = settings_from_header(h);
+  if (!app.count("--edges")) s.edges = from.edges;
+  if (!app.count("--seed")) s.seed = from.seed;
+  if (!app.count("--min-duration")) s.command.min_duration = from.command.min_duration;
+  if (!app.count("--max-duration")) s.command.max_duration = from.command.max_duration;
+  if (!app.count("--knot-interval")) s.command.knot_interval = from.command.knot_interval;
+  if (!app.count("--velocity-scale")) s.command.velocity_scale = from.command.velocity_scale;
+  if (!app.count("--limit-scale")) s.command.limit_scale = from.command.limit_scale;
+  if (!app.count("--integrator")) s.simulation.integrator = from.simulation.integrator;
+  if (!app.count("--substeps")) s.simulation.substeps = from.simulation.substeps;
+  if (!app.count("--sample-interval")) o.sample_interval = h.sample_interval;
+  if (!app.count("--theta")) s.design_theta = from.design_theta;
+  if (!app.count("--region")) {
+    s.region_lower = from.region_lower;
+    s.region_upper = from.region_upper;
+  }
+}
+
+// Prepares `existing` to grow to the new target after check_resume_compatible. False when it
+// is complete at that target already (nothing to do).
+bool prepare_resume(Bundle& existing, const BuildOptions& o) {
+  const BuildSettings& s = o.settings;
+  if (existing.size() > s.edges) {
+    fail("--edges", "the file already holds " + std::to_string(existing.size()) + " edges");
+  }
+  if (existing.size() == s.edges && existing.header.complete) {
+    if (!o.control.quiet) {
+      std::fprintf(stderr, "lazyboe-build: %s is already complete with %zu edges\n",
+                   o.out_path.c_str(), existing.size());
+    }
+    return false;
+  }
+  existing.header.target_edges = s.edges;
+  existing.header.complete = false;
+  existing.header.tool_version = version();
+  if (existing.perturbation.present) {
+    // New edges have no perturbation counts: the analysis has to be run again.
+    existing.perturbation = Perturbation{};
+    if (!o.control.quiet) {
+      std::fprintf(stderr,
+                   "lazyboe-build: the perturbation analysis in %s is dropped; run "
+                   "lazyboe-perturb again\n",
+                   o.out_path.c_str());
+    }
+  }
+  if (!o.control.quiet) {
+    std::fprintf(stderr, "lazyboe-build: resuming %s at %zu of %llu edges\n", o.out_path.c_str(),
+                 existing.size(), static_cast<unsigned long long>(s.edges));
+  }
+  return true;
+}
+
+// Builds (or resumes) the bundle until complete or interrupted; returns the exit status.
+int grow_bundle(const Simulator& sim, BuildOptions& o, Bundle& bundle) {
+  install_stop_handlers();
+  o.control.stop_requested = stop_requested;
+  o.control.save_checkpoint = [&](const Bundle& b) { write_bundle(o.out_path, b); };
+  const BuildOutcome outcome = build_bundle(sim, o.settings, bundle, o.control);
+  if (!o.control.quiet) print_summary(bundle);
+  if (outcome == BuildOutcome::Interrupted) {
+    std::fprintf(stderr,
+                 "lazyboe-build: interrupted; %s holds %zu edges. Continue with: lazyboe-build "
+                 "--resume --out %s\n",
+                 o.out_path.c_str(), bundle.size(), o.out_path.c_str());
+    return 130;
+  }
+  return 0;
+}
+
+int run(const CLI::App& app, BuildOptions& o) {
+  if (!o.inspect_path.empty()) {
+    print_inspection(o.inspect_path, stdout);
+    return 0;
+  }
+  check_options(o);
+  BuildSettings& s = o.settings;
+  s.simulation.integrator = parse_integrator(o.integrator, "--integrator");
+
+  Bundle existing;
+  const bool exists = std::filesystem::exists(o.out_path);
+  if (o.resume) {
+    if (!exists) fail(o.out_path, "cannot resume: no such file");
+    existing = read_bundle(o.out_path);
+    take_settings_from(app, existing.header, o);
+  } else if (exists && !o.force) {
+    fail(o.out_path, "already exists (use --force to overwrite, or --resume to continue it)");
+  }
+
+  const RobotModel robot = load_robot(o.robot_path);
+  const Environment env = load_environment(o.env_path);
+  const CollisionModel collision = build_collision_model(robot, env);
+  s.simulation.sample_every =
+      exact_sample_every_ticks(o.sample_interval, robot.control_rate, "--sample-interval");
+  if (!o.resume || app.count("--region"))
+    parse_region(o.region, robot, s.region_lower, s.region_upper);
+  const Simulator sim(robot, collision, s.simulation);
+  check_region(sim, s);
+
+  Bundle bundle = new_bundle(robot, env, s);
+  if (o.resume) {
+    check_resume_compatible(existing.header, bundle.header, o.out_path);
+    if (!prepare_resume(existing, o)) return 0;
+    bundle = std::move(existing);
+  }
+  return grow_bundle(sim, o, bundle);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Generate an edge bundle: valid random rollouts of the robot's dynamics, in HDF5."};
+  BuildOptions options;
+  add_options(app, options);
   one_line_cli_errors(app, "lazyboe-build");
   CLI11_PARSE(app, argc, argv);
-
-  return run_tool("lazyboe-build", [&]() -> int {
-    if (!inspect_path.empty()) {
-      print_inspection(inspect_path, stdout);
-      return 0;
-    }
-    if (out_path.empty()) fail("--out", "required (the bundle file to write)");
-    if (resume && force) fail("--resume", "cannot be combined with --force");
-    if (s.edges == 0) fail("--edges", "must be > 0");
-    if (!(s.command.min_duration > 0)) fail("--min-duration", "must be > 0");
-    if (!(s.command.max_duration >= s.command.min_duration)) {
-      fail("--max-duration", "must be >= --min-duration");
-    }
-    if (!(s.command.knot_interval > 0)) fail("--knot-interval", "must be > 0");
-    if (!(s.command.velocity_scale > 0 && s.command.velocity_scale <= 1))
-      fail("--velocity-scale", "must be in (0, 1]");
-    if (!(s.command.limit_scale > 0 && s.command.limit_scale <= 1))
-      fail("--limit-scale", "must be in (0, 1]");
-    if (s.simulation.substeps < 1) fail("--substeps", "must be >= 1");
-    if (!(s.design_theta > 0)) fail("--theta", "must be > 0");
-    if (control.threads < 0) fail("--threads", "must be >= 0");
-    if (!(sample_interval >= 0)) fail("--sample-interval", "must be >= 0");
-    s.simulation.integrator = parse_integrator(integrator);
-
-    // A resumed build takes every setting from the file; options given now must agree with it.
-    Bundle existing;
-    const bool exists = std::filesystem::exists(out_path);
-    if (resume) {
-      if (!exists) fail(out_path, "cannot resume: no such file");
-      existing = read_bundle(out_path);
-      const BundleHeader& h = existing.header;
-      if (!app.count("--robot")) robot_path = h.robot_config;
-      if (!app.count("--env")) env_path = h.env_file;
-      const BuildSettings from = settings_from_header(h);
-      if (!app.count("--edges")) s.edges = from.edges;
-      if (!app.count("--seed")) s.seed = from.seed;
-      if (!app.count("--min-duration")) s.command.min_duration = from.command.min_duration;
-      if (!app.count("--max-duration")) s.command.max_duration = from.command.max_duration;
-      if (!app.count("--knot-interval")) s.command.knot_interval = from.command.knot_interval;
-      if (!app.count("--velocity-scale")) s.command.velocity_scale = from.command.velocity_scale;
-      if (!app.count("--limit-scale")) s.command.limit_scale = from.command.limit_scale;
-      if (!app.count("--integrator")) s.simulation.integrator = from.simulation.integrator;
-      if (!app.count("--substeps")) s.simulation.substeps = from.simulation.substeps;
-      if (!app.count("--sample-interval")) sample_interval = h.sample_interval;
-      if (!app.count("--theta")) s.design_theta = from.design_theta;
-      if (!app.count("--region")) {
-        s.region_lower = from.region_lower;
-        s.region_upper = from.region_upper;
-      }
-    } else if (exists && !force) {
-      fail(out_path, "already exists (use --force to overwrite, or --resume to continue it)");
-    }
-
-    const RobotModel robot = load_robot(robot_path);
-    const Environment env = load_environment(env_path);
-    const CollisionModel collision = build_collision_model(robot, env);
-    s.simulation.sample_every = static_cast<int>(std::lround(sample_interval * robot.control_rate));
-    if (sample_interval > 0 &&
-        std::abs(s.simulation.sample_every / robot.control_rate - sample_interval) > 1e-9) {
-      fail("--sample-interval", "must be a multiple of the control period (" +
-                                    std::to_string(1 / robot.control_rate) + " s)");
-    }
-    if (!resume || app.count("--region"))
-      parse_region(region, robot, s.region_lower, s.region_upper);
-    const Simulator sim(robot, collision, s.simulation);
-    check_region(sim, s);
-
-    Bundle bundle = new_bundle(robot, env, s);
-    if (resume) {
-      check_resume_compatible(existing.header, bundle.header, out_path);
-      if (existing.size() > s.edges) {
-        fail("--edges", "the file already holds " + std::to_string(existing.size()) + " edges");
-      }
-      if (existing.size() == s.edges && existing.header.complete) {
-        if (!control.quiet) {
-          std::fprintf(stderr, "lazyboe-build: %s is already complete with %zu edges\n",
-                       out_path.c_str(), existing.size());
-        }
-        return 0;
-      }
-      existing.header.target_edges = s.edges;
-      existing.header.complete = false;
-      existing.header.tool_version = version();
-      if (existing.perturbation.present) {
-        // New edges have no perturbation counts: the analysis has to be run again.
-        existing.perturbation = Perturbation{};
-        if (!control.quiet) {
-          std::fprintf(stderr,
-                       "lazyboe-build: the perturbation analysis in %s is dropped; run "
-                       "lazyboe-perturb again\n",
-                       out_path.c_str());
-        }
-      }
-      bundle = std::move(existing);
-      if (!control.quiet) {
-        std::fprintf(stderr, "lazyboe-build: resuming %s at %zu of %llu edges\n", out_path.c_str(),
-                     bundle.size(), static_cast<unsigned long long>(s.edges));
-      }
-    }
-
-    install_stop_handlers();
-    control.stop_requested = stop_requested;
-    control.save_checkpoint = [&](const Bundle& b) { write_bundle(out_path, b); };
-    const BuildOutcome outcome = build_bundle(sim, s, bundle, control);
-    if (!control.quiet) print_summary(bundle);
-    if (outcome == BuildOutcome::Interrupted) {
-      std::fprintf(stderr,
-                   "lazyboe-build: interrupted; %s holds %zu edges. Continue with: lazyboe-build "
-                   "--resume --out %s\n",
-                   out_path.c_str(), bundle.size(), out_path.c_str());
-      return 130;
-    }
-    return 0;
-  });
+  return run_tool("lazyboe-build", [&]() -> int { return run(app, options); });
 }

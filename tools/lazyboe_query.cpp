@@ -11,6 +11,7 @@
 #include <map>
 #include <memory>
 
+#include "lazyboe/common/atomic_file.h"
 #include "lazyboe/common/histogram.h"
 #include "lazyboe/io/query_io.h"
 #include "lazyboe/planning/planning_session.h"
@@ -227,29 +228,19 @@ int run(const Options& o) {
   const PlanningSession session(o.bundle_path, !o.no_mmap, o.robot_path, o.env_path);
   report_load(o, session);
   Job job{session, session.context(), QueryDefaults{}, 1, mode, o.trajectory_dir};
-  job.sample_every = std::max(
-      1, static_cast<int>(std::lround(o.sample_interval * session.scene.robot.control_rate)));
+  job.sample_every =
+      std::max(1, sample_every_ticks(o.sample_interval, session.scene.robot.control_rate));
 
   // Output: a file written under a temporary name (renamed at the end), or standard output.
   const bool to_stdout = o.out_path == "-";
-  const std::string tmp_path = o.out_path + ".tmp." + std::to_string(::getpid());
-  std::ofstream file_out;
-  if (!to_stdout) {
-    file_out.open(tmp_path);
-    if (!file_out) fail(o.out_path, "cannot write");
-  }
-  std::ostream& out = to_stdout ? std::cout : file_out;
+  std::unique_ptr<AtomicFile> file;
+  if (!to_stdout) file = std::make_unique<AtomicFile>(o.out_path);
+  std::ostream& out = to_stdout ? std::cout : file->stream();
   const int sim_threads = sim_threads_for(o);
   const std::vector<Outcome> outcomes =
       o.queries_path == "-" ? answer_stream(job, out, sim_threads)
                             : answer_file(job, o.queries_path, out, o.jobs, sim_threads);
-  if (!to_stdout) {
-    file_out.close();
-    if (!file_out || std::rename(tmp_path.c_str(), o.out_path.c_str()) != 0) {
-      std::remove(tmp_path.c_str());
-      fail(o.out_path, "cannot write");
-    }
-  }
+  if (file) file->commit();
   if (!o.quiet) print_summary(outcomes);
   return 0;
 }

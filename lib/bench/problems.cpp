@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <fstream>
 
+#include "lazyboe/common/atomic_file.h"
 #include "lazyboe/common/error.h"
 #include "lazyboe/sim/random.h"
 
@@ -69,25 +70,21 @@ std::vector<BenchProblem> read_problems(const std::string& path, const Simulator
 
 void write_problems(const std::string& path, const RobotModel& robot,
                     const std::vector<BenchProblem>& problems) {
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream out(tmp);
-    if (!out) fail(path, "cannot write");
-    for (const BenchProblem& p : problems) {
-      nlohmann::json goal;
-      if (p.goal.kind == Goal::Kind::Joint) {
-        goal = {{"q", vector_json(p.goal.q)}, {"tolerance", p.goal.tolerance}};
-      } else {
-        goal = {{"position", {p.goal.position.x(), p.goal.position.y(), p.goal.position.z()}},
-                {"link", robot.links[p.goal.link].name},
-                {"tolerance", p.goal.tolerance}};
-      }
-      out << nlohmann::json{{"id", p.id}, {"start", vector_json(p.start)}, {"goal", goal}}.dump()
-          << "\n";
+  AtomicFile file(path);
+  for (const BenchProblem& p : problems) {
+    nlohmann::json goal;
+    if (p.goal.kind == Goal::Kind::Joint) {
+      goal = {{"q", vector_json(p.goal.q)}, {"tolerance", p.goal.tolerance}};
+    } else {
+      goal = {{"position", {p.goal.position.x(), p.goal.position.y(), p.goal.position.z()}},
+              {"link", robot.links[p.goal.link].name},
+              {"tolerance", p.goal.tolerance}};
     }
-    if (!out.flush()) fail(path, "cannot write");
+    file.stream()
+        << nlohmann::json{{"id", p.id}, {"start", vector_json(p.start)}, {"goal", goal}}.dump()
+        << "\n";
   }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) fail(path, "cannot write");
+  file.commit();
 }
 
 }  // namespace lazyboe

@@ -9,6 +9,7 @@
 #include <map>
 #include <sstream>
 
+#include "lazyboe/common/atomic_file.h"
 #include "lazyboe/common/error.h"
 #include "lazyboe/common/histogram.h"
 #include "lazyboe/common/statistics.h"
@@ -186,17 +187,13 @@ std::vector<RunRecord> read_runs_csv(const std::string& path,
 
 void write_runs_csv(const std::string& path, const std::vector<RunRecord>& runs,
                     const std::vector<std::string>& problem_ids) {
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream out(tmp);
-    if (!out) fail(path, "cannot write");
-    std::string header;
-    for (const std::string& c : runs_csv_header()) header += (header.empty() ? "" : ",") + c;
-    out << header << "\n";
-    for (const RunRecord& r : runs) out << runs_csv_row(r, problem_ids.at(r.problem)) << "\n";
-    if (!out.flush()) fail(path, "cannot write");
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) fail(path, "cannot write");
+  AtomicFile file(path);
+  std::ostream& out = file.stream();
+  std::string header;
+  for (const std::string& c : runs_csv_header()) header += (header.empty() ? "" : ",") + c;
+  out << header << "\n";
+  for (const RunRecord& r : runs) out << runs_csv_row(r, problem_ids.at(r.problem)) << "\n";
+  file.commit();
 }
 
 namespace {
@@ -226,6 +223,57 @@ std::string test_cell(const std::vector<double>& lazy, const std::vector<double>
   return "U = " + fixed(t.u1, 1) + ", p = " + format_p_value(t.p) + " " + significance_mark(t.p);
 }
 
+double success_rate(const PlannerStats& s) {
+  return s.runs ? static_cast<double>(s.successes) / s.runs
+                : std::numeric_limits<double>::quiet_NaN();
+}
+
+// The paper's targets for LazyBoE, each met or not (stats has a "lazyboe" entry with runs).
+void write_targets(std::ostream& md, std::map<std::string, PlannerStats>& stats,
+                   const std::vector<PlannerSpec>& specs) {
+  const PlannerStats& lazy = stats["lazyboe"];
+  md << "\n## Targets\n\n";
+  auto verdict = [](bool ok) { return ok ? "**met**" : "**not met**"; };
+  const double lazy_median = median_of(lazy.ttfs);
+  if (stats.count("ompl-sst") && stats["ompl-sst"].runs > 0) {
+    const double sst_median = median_of(stats["ompl-sst"].ttfs);
+    const double ratio = sst_median / lazy_median;
+    md << "- LazyBoE's median time to first solution at least 10x lower than OMPL's SST: ";
+    if (std::isfinite(ratio)) {
+      md << fixed(lazy_median, 3) << " s against " << fixed(sst_median, 3) << " s, "
+         << fixed(ratio, 1) << "x: " << verdict(ratio >= 10) << "\n";
+    } else {
+      md << "not measurable (no successful run of one of them)\n";
+    }
+  } else {
+    md << "- LazyBoE against OMPL's SST: not measured (ompl-sst not in this study)\n";
+  }
+  bool best = true;
+  std::string worse;
+  for (const PlannerSpec& spec : specs) {
+    if (spec.name == "lazyboe" || !spec.available || !stats[spec.name].runs) continue;
+    if (success_rate(stats[spec.name]) > success_rate(lazy)) {
+      best = false;
+      worse += (worse.empty() ? "" : ", ") + spec.name;
+    }
+  }
+  md << "- Success rate at least every baseline's and at least 92%: "
+     << fixed(100 * success_rate(lazy), 0) << "%" << (best ? "" : " (" + worse + " higher)") << ": "
+     << verdict(best && success_rate(lazy) >= 0.92) << "\n";
+  if (stats.count("boe") && stats["boe"].runs > 0) {
+    const double boe_cost = median_of(stats["boe"].cost), lazy_cost = median_of(lazy.cost);
+    md << "- Final cost no worse than BoE's (median): ";
+    if (std::isfinite(lazy_cost) && std::isfinite(boe_cost)) {
+      md << fixed(lazy_cost, 2) << " rad against " << fixed(boe_cost, 2)
+         << " rad: " << verdict(lazy_cost <= boe_cost) << "\n";
+    } else {
+      md << "not measurable (no successful run of one of them)\n";
+    }
+  } else {
+    md << "- Final cost against BoE: not measured (boe not in this study)\n";
+  }
+}
+
 }  // namespace
 
 std::string summary_markdown(const StudyInfo& info, const std::vector<PlannerSpec>& specs,
@@ -241,11 +289,6 @@ std::string summary_markdown(const StudyInfo& info, const std::vector<PlannerSpe
     s.ttfs.push_back(r.time_to_first_solution);
     s.cost.push_back(r.best_cost);
   }
-  auto rate = [](const PlannerStats& s) {
-    return s.runs ? static_cast<double>(s.successes) / s.runs
-                  : std::numeric_limits<double>::quiet_NaN();
-  };
-
   std::ostringstream md;
   md << "# lazyboe-bench summary\n\n";
   md << "- Bundle: `" << info.bundle << "` (" << info.edges << " edges), robot `" << info.robot
@@ -269,7 +312,7 @@ std::string summary_markdown(const StudyInfo& info, const std::vector<PlannerSpe
       continue;
     }
     const PlannerStats& s = stats[spec.name];
-    md << "| " << spec.name << " | " << s.runs << " | " << fixed(100 * rate(s), 0) << "% | "
+    md << "| " << spec.name << " | " << s.runs << " | " << fixed(100 * success_rate(s), 0) << "% | "
        << fixed(median_of(s.ttfs), 3) << " | " << fixed(mean_of(s.ttfs), 3) << " | "
        << fixed(median_of(s.cost), 2) << " | " << fixed(mean_of(s.cost), 2) << " | "
        << fixed(mean_of(s.solutions), 2) << " | " << fixed(median_of(s.simulations), 0) << " |\n";
@@ -291,46 +334,7 @@ std::string summary_markdown(const StudyInfo& info, const std::vector<PlannerSpe
          << " |\n";
     }
 
-    md << "\n## Targets\n\n";
-    auto verdict = [](bool ok) { return ok ? "**met**" : "**not met**"; };
-    const double lazy_median = median_of(lazy.ttfs);
-    if (stats.count("ompl-sst") && stats["ompl-sst"].runs > 0) {
-      const double sst_median = median_of(stats["ompl-sst"].ttfs);
-      const double ratio = sst_median / lazy_median;
-      md << "- LazyBoE's median time to first solution at least 10x lower than OMPL's SST: ";
-      if (std::isfinite(ratio)) {
-        md << fixed(lazy_median, 3) << " s against " << fixed(sst_median, 3) << " s, "
-           << fixed(ratio, 1) << "x: " << verdict(ratio >= 10) << "\n";
-      } else {
-        md << "not measurable (no successful run of one of them)\n";
-      }
-    } else {
-      md << "- LazyBoE against OMPL's SST: not measured (ompl-sst not in this study)\n";
-    }
-    bool best = true;
-    std::string worse;
-    for (const PlannerSpec& spec : specs) {
-      if (spec.name == "lazyboe" || !spec.available || !stats[spec.name].runs) continue;
-      if (rate(stats[spec.name]) > rate(lazy)) {
-        best = false;
-        worse += (worse.empty() ? "" : ", ") + spec.name;
-      }
-    }
-    md << "- Success rate at least every baseline's and at least 92%: "
-       << fixed(100 * rate(lazy), 0) << "%" << (best ? "" : " (" + worse + " higher)") << ": "
-       << verdict(best && rate(lazy) >= 0.92) << "\n";
-    if (stats.count("boe") && stats["boe"].runs > 0) {
-      const double boe_cost = median_of(stats["boe"].cost), lazy_cost = median_of(lazy.cost);
-      md << "- Final cost no worse than BoE's (median): ";
-      if (std::isfinite(lazy_cost) && std::isfinite(boe_cost)) {
-        md << fixed(lazy_cost, 2) << " rad against " << fixed(boe_cost, 2)
-           << " rad: " << verdict(lazy_cost <= boe_cost) << "\n";
-      } else {
-        md << "not measurable (no successful run of one of them)\n";
-      }
-    } else {
-      md << "- Final cost against BoE: not measured (boe not in this study)\n";
-    }
+    write_targets(md, stats, specs);
   }
 
   bool any_skipped = false;

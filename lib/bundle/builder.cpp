@@ -10,7 +10,6 @@
 
 #include "lazyboe/common/checkpoint.h"
 #include "lazyboe/common/error.h"
-#include "lazyboe/common/hash.h"
 #include "lazyboe/common/progress.h"
 #include "lazyboe/common/version.h"
 
@@ -22,16 +21,8 @@ const char* EdgeAttempt::reason() const {
 
 namespace {
 
-const char* integrator_name(Integrator integrator) {
-  return integrator == Integrator::RK4 ? "rk4" : "euler";
-}
-
 std::vector<double> to_std(const JointVector& v) {
   return std::vector<double>(v.data(), v.data() + v.size());
-}
-
-JointVector from_std(const std::vector<double>& v) {
-  return Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size()));
 }
 
 // Start-state stream of an attempt: the same generator as the attempt's, drawn first.
@@ -113,52 +104,11 @@ Bundle new_bundle(const RobotModel& robot, const Environment& env, const BuildSe
   h.integrator = integrator_name(s.simulation.integrator);
   h.substeps = s.simulation.substeps;
   h.control_rate = robot.control_rate;
-  h.sample_interval = s.simulation.sample_every / robot.control_rate;
+  h.sample_interval = sample_interval_seconds(s.simulation.sample_every, robot.control_rate);
   h.design_theta = s.design_theta;
   b.knot_offset = {0};
   b.sample_offset = {0};
   return b;
-}
-
-std::string robot_identity(const RobotModel& robot) {
-  return hash_files({robot.config_path, robot.urdf_path});
-}
-
-std::string environment_identity(const Environment& env) { return hash_files({env.path}); }
-
-BundleScene load_bundle_scene(const BundleHeader& h, std::string robot_path, std::string env_path) {
-  if (robot_path.empty()) robot_path = h.robot_config;
-  if (env_path.empty()) env_path = h.env_file;
-  BundleScene scene{load_robot(robot_path), load_environment(env_path)};
-  const std::string robot_hash = robot_identity(scene.robot);
-  if (robot_hash != h.robot_hash) {
-    fail(robot_path, "is not the robot the bundle was built with (" + h.robot_config + ", hash " +
-                         h.robot_hash + "; this one hashes to " + robot_hash + ")");
-  }
-  const std::string env_hash = environment_identity(scene.env);
-  if (env_hash != h.env_hash) {
-    fail(env_path, "is not the environment the bundle was built with (" + h.env_file + ", hash " +
-                       h.env_hash + "; this one hashes to " + env_hash + ")");
-  }
-  return scene;
-}
-
-BuildSettings settings_from_header(const BundleHeader& h) {
-  BuildSettings s;
-  s.edges = h.target_edges;
-  s.seed = h.seed;
-  s.region_lower = from_std(h.region_lower);
-  s.region_upper = from_std(h.region_upper);
-  s.command.min_duration = h.min_duration;
-  s.command.max_duration = h.max_duration;
-  s.command.knot_interval = h.knot_interval;
-  s.command.velocity_scale = h.velocity_scale;
-  s.command.limit_scale = h.limit_scale;
-  s.simulation.integrator = h.integrator == "rk4" ? Integrator::RK4 : Integrator::SemiImplicitEuler;
-  s.simulation.substeps = h.substeps;
-  s.simulation.sample_every = static_cast<int>(std::lround(h.sample_interval * h.control_rate));
-  s.design_theta = h.design_theta;
-  return s;
 }
 
 void check_resume_compatible(const BundleHeader& have, const BundleHeader& want,

@@ -10,19 +10,11 @@
 #include <vector>
 
 #include "lazyboe/bundle/bundle.h"
+#include "lazyboe/bundle/scene.h"
+#include "lazyboe/bundle/settings.h"
 #include "lazyboe/sim/simulator.h"
 
 namespace lazyboe {
-
-// Everything that decides the bundle's contents (all stored in its header).
-struct BuildSettings {
-  uint64_t edges = 100000;
-  uint64_t seed = 1;
-  JointVector region_lower, region_upper;
-  CommandSampling command;
-  SimulationOptions simulation;
-  double design_theta = 0.35;
-};
 
 // How the build runs, not what it makes.
 struct BuildControl {
@@ -52,23 +44,6 @@ void generate_edge(const Simulator& sim, SimulatorWorkspace& ws, const BuildSett
 
 // A new, empty bundle whose header describes the inputs and settings.
 Bundle new_bundle(const RobotModel& robot, const Environment& env, const BuildSettings& settings);
-
-// The settings a bundle header records (for resuming, and for re-simulating its edges).
-BuildSettings settings_from_header(const BundleHeader& header);
-
-// Content identity of the inputs, as recorded in a bundle header.
-std::string robot_identity(const RobotModel& robot);  // hash of config + URDF bytes
-std::string environment_identity(const Environment& env);
-
-// The robot and environment a bundle was built with: the files given, or those recorded in the
-// header when a path is empty, refused (naming the file) unless their content hashes to the
-// recorded values. Other tools never assume them.
-struct BundleScene {
-  RobotModel robot;
-  Environment env;
-};
-BundleScene load_bundle_scene(const BundleHeader& header, std::string robot_path,
-                              std::string env_path);
 
 // Refuses to resume `existing` with `wanted`: names the first parameter, robot or environment
 // that differs.

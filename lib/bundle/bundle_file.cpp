@@ -1,14 +1,7 @@
 #include "lazyboe/bundle/bundle_file.h"
 
-#include <fcntl.h>
-#include <unistd.h>
-
-#include <cerrno>
-#include <cstdio>
-#include <cstring>
-#include <filesystem>
-
 #include "lazyboe/bundle/hdf5_handle.h"
+#include "lazyboe/common/atomic_file.h"
 #include "lazyboe/common/error.h"
 
 namespace lazyboe {
@@ -172,13 +165,42 @@ uint64_t rows_of(const std::string& where, hid_t file, const char* name, uint64_
   return found[0];
 }
 
-void fsync_path(const std::string& path, bool directory) {
-  const int fd = ::open(path.c_str(), directory ? (O_RDONLY | O_DIRECTORY) : O_RDWR);
-  if (fd < 0) fail(path, "cannot open to sync: " + std::string(std::strerror(errno)));
-  const int rc = ::fsync(fd);
-  const int err = errno;
-  ::close(fd);
-  if (rc != 0) fail(path, "cannot sync to disk: " + std::string(std::strerror(err)));
+void write_edges(const std::string& tmp, hid_t file, const Bundle& b) {
+  const uint64_t n = b.size(), dof = static_cast<uint64_t>(b.dof());
+  const uint64_t k = b.knots.size() / dof, s = b.sample_q.size() / dof;
+  h5::create_group(tmp, file, "/edges");
+  h5::create_group(tmp, file, "/controls");
+  h5::create_group(tmp, file, "/trajectory");
+  h5::write_dataset(tmp, file, ds::q0, b.q0, {n, dof});
+  h5::write_dataset(tmp, file, ds::qf, b.qf, {n, dof});
+  h5::write_dataset(tmp, file, ds::duration, b.duration, {n});
+  h5::write_dataset(tmp, file, ds::command_duration, b.command_duration, {n});
+  h5::write_dataset(tmp, file, ds::attempt, b.attempt, {n});
+  h5::write_dataset(tmp, file, ds::knot_offset, b.knot_offset, {n + 1});
+  h5::write_dataset(tmp, file, ds::sample_offset, b.sample_offset, {n + 1});
+  h5::write_dataset(tmp, file, ds::knots, b.knots, {k, dof});
+  h5::write_dataset(tmp, file, ds::sample_q, b.sample_q, {s, dof});
+  h5::write_dataset(tmp, file, ds::sample_dq, b.sample_dq, {s, dof});
+}
+
+void write_perturbation(const std::string& tmp, hid_t file, const Perturbation& p, uint64_t n) {
+  h5::Group g = h5::create_group(tmp, file, ds::perturbation);
+  h5::write_attr_bool(tmp, g, "complete", p.complete);
+  h5::write_attr_f64(tmp, g, "theta", p.theta);
+  h5::write_attr_u64(tmp, g, "perturbations", p.perturbations);
+  h5::write_attr_u64(tmp, g, "seed", p.seed);
+  h5::write_attr_f64(tmp, g, "wall_seconds", p.wall_seconds);
+  h5::write_attr_f64(tmp, g, "simulated_seconds", p.simulated_seconds);
+  h5::write_attr_string(
+      tmp, g, "distribution",
+      "start + d, d = r u: u uniform on the unit sphere, r uniform in (0, theta]");
+  h5::write_dataset(tmp, file, ds::pert_done, p.done, {n});
+  h5::write_dataset(tmp, file, ds::pert_valid, p.valid, {n});
+  h5::write_dataset(tmp, file, ds::pert_lazy, p.lazy, {n});
+  h5::write_dataset(tmp, file, ds::pert_collision, p.collision, {n});
+  h5::write_dataset(tmp, file, ds::pert_max_error, p.max_error, {n});
+  h5::write_dataset(tmp, file, ds::p_lazy_prop, p.p_lazy_prop, {n});
+  h5::write_dataset(tmp, file, ds::p_collision, p.p_collision, {n});
 }
 
 }  // namespace
@@ -223,62 +245,16 @@ void check_bundle(const Bundle& b, const std::string& where) {
 
 void write_bundle(const std::string& path, const Bundle& b) {
   check_bundle(b, path);
-  const std::string tmp = path + ".tmp." + std::to_string(::getpid());
-  const uint64_t n = b.size(), dof = static_cast<uint64_t>(b.dof());
-  const uint64_t k = b.knots.size() / dof, s = b.sample_q.size() / dof;
-  try {
-    {
-      h5::File file = h5::create_file(tmp);
-      write_header(tmp, file, b.header, n);
-      h5::create_group(tmp, file, "/edges");
-      h5::create_group(tmp, file, "/controls");
-      h5::create_group(tmp, file, "/trajectory");
-      h5::write_dataset(tmp, file, ds::q0, b.q0, {n, dof});
-      h5::write_dataset(tmp, file, ds::qf, b.qf, {n, dof});
-      h5::write_dataset(tmp, file, ds::duration, b.duration, {n});
-      h5::write_dataset(tmp, file, ds::command_duration, b.command_duration, {n});
-      h5::write_dataset(tmp, file, ds::attempt, b.attempt, {n});
-      h5::write_dataset(tmp, file, ds::knot_offset, b.knot_offset, {n + 1});
-      h5::write_dataset(tmp, file, ds::sample_offset, b.sample_offset, {n + 1});
-      h5::write_dataset(tmp, file, ds::knots, b.knots, {k, dof});
-      h5::write_dataset(tmp, file, ds::sample_q, b.sample_q, {s, dof});
-      h5::write_dataset(tmp, file, ds::sample_dq, b.sample_dq, {s, dof});
-      if (b.perturbation.present) {
-        const Perturbation& p = b.perturbation;
-        h5::Group g = h5::create_group(tmp, file, ds::perturbation);
-        h5::write_attr_bool(tmp, g, "complete", p.complete);
-        h5::write_attr_f64(tmp, g, "theta", p.theta);
-        h5::write_attr_u64(tmp, g, "perturbations", p.perturbations);
-        h5::write_attr_u64(tmp, g, "seed", p.seed);
-        h5::write_attr_f64(tmp, g, "wall_seconds", p.wall_seconds);
-        h5::write_attr_f64(tmp, g, "simulated_seconds", p.simulated_seconds);
-        h5::write_attr_string(
-            tmp, g, "distribution",
-            "start + d, d = r u: u uniform on the unit sphere, r uniform in (0, theta]");
-        h5::write_dataset(tmp, file, ds::pert_done, p.done, {n});
-        h5::write_dataset(tmp, file, ds::pert_valid, p.valid, {n});
-        h5::write_dataset(tmp, file, ds::pert_lazy, p.lazy, {n});
-        h5::write_dataset(tmp, file, ds::pert_collision, p.collision, {n});
-        h5::write_dataset(tmp, file, ds::pert_max_error, p.max_error, {n});
-        h5::write_dataset(tmp, file, ds::p_lazy_prop, p.p_lazy_prop, {n});
-        h5::write_dataset(tmp, file, ds::p_collision, p.p_collision, {n});
-      }
-      h5::close_file(tmp, file);
-    }
-    fsync_path(tmp, false);
-    if (std::rename(tmp.c_str(), path.c_str()) != 0)
-      fail(path, "cannot rename " + tmp + " into place: " + std::strerror(errno));
-  } catch (...) {
-    ::unlink(tmp.c_str());
-    throw;
+  AtomicFile out(path, AtomicFile::Writer::External);
+  const std::string& tmp = out.temp_path();
+  {
+    h5::File file = h5::create_file(tmp);
+    write_header(tmp, file, b.header, b.size());
+    write_edges(tmp, file, b);
+    if (b.perturbation.present) write_perturbation(tmp, file, b.perturbation, b.size());
+    h5::close_file(tmp, file);
   }
-  // Make the rename itself durable. The new file is in place already, so a failure here is
-  // not worth an error.
-  std::string dir = std::filesystem::path(path).parent_path().string();
-  try {
-    fsync_path(dir.empty() ? "." : dir, true);
-  } catch (const Error&) {
-  }
+  out.commit();
 }
 
 void require_complete(const BundleHeader& h, const std::string& path) {

@@ -6,8 +6,6 @@
 // problem as one Error line naming the file and the dataset or attribute at fault.
 #pragma once
 
-#include <hdf5.h>
-
 #include <cstdint>
 #include <string>
 
@@ -70,7 +68,6 @@ struct DatasetLocation {
   uint64_t bytes = 0;
 };
 DatasetLocation dataset_location(const std::string& path, const std::string& dataset);
-// The same on an already open file; `where` names it in errors.
-DatasetLocation dataset_location(const std::string& where, hid_t file, const std::string& dataset);
+// (The same on an already open HDF5 file is in hdf5_handle.h, which is not installed.)
 
 }  // namespace lazyboe

@@ -155,3 +155,12 @@ std::vector<std::string> read_attr_strings(const std::string& where, hid_t obj,
                                            const std::string& name);
 
 }  // namespace lazyboe::h5
+
+namespace lazyboe {
+
+// bundle_file.h's dataset_location on an already open file; `where` names it in errors. Here,
+// not there, so that the installed bundle_file.h does not include <hdf5.h>.
+struct DatasetLocation;
+DatasetLocation dataset_location(const std::string& where, hid_t file, const std::string& dataset);
+
+}  // namespace lazyboe

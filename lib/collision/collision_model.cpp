@@ -7,10 +7,14 @@
 #include <algorithm>
 #include <cmath>
 
+#include "lazyboe/collision/fcl_shapes.h"
 #include "lazyboe/common/error.h"
 
 namespace lazyboe {
 namespace {
+
+static_assert(sizeof(CollisionShapes::Robot) == sizeof(Eigen::Vector3d),
+              "a robot shape's record has the stride of its sphere centre");
 
 std::shared_ptr<fcl::CollisionGeometryd> make_geometry(const Shape& s, double inflate) {
   switch (s.type) {
@@ -54,6 +58,12 @@ Eigen::Vector3d bounding_half_extents(const Shape& s) {
   return Eigen::Vector3d::Zero();
 }
 
+const fcl::CollisionGeometryd* own(CollisionShapes& shapes,
+                                   std::shared_ptr<fcl::CollisionGeometryd> geometry) {
+  shapes.owned.push_back(std::move(geometry));
+  return shapes.owned.back().get();
+}
+
 fcl::Transform3d to_fcl(const Pose& pose) {
   fcl::Transform3d t = fcl::Transform3d::Identity();
   t.linear() = pose.R;
@@ -63,15 +73,15 @@ fcl::Transform3d to_fcl(const Pose& pose) {
 
 // Can a robot shape's bounding sphere touch an obstacle's world bounding box?
 inline bool sphere_may_touch_box(const Eigen::Vector3d& centre, double radius,
-                                 const CollisionModel::ObstacleShape& o) {
+                                 const CollisionShapes::Obstacle& o) {
   const Eigen::Vector3d outside =
       (o.box_min - centre).cwiseMax(centre - o.box_max).cwiseMax(Eigen::Vector3d::Zero());
   return outside.squaredNorm() <= radius * radius;
 }
 
-inline bool spheres_may_touch(const CollisionData& data, const CollisionModel& model, int a, int b,
-                              double grow) {
-  const double r = model.robot[a].sphere_radius + model.robot[b].sphere_radius + grow;
+inline bool spheres_may_touch(const CollisionData& data, const CollisionShapes& shapes, int a,
+                              int b, double grow) {
+  const double r = shapes.robot[a].sphere_radius + shapes.robot[b].sphere_radius + grow;
   return (data.sphere_centre[a] - data.sphere_centre[b]).squaredNorm() <= r * r;
 }
 
@@ -92,38 +102,37 @@ double narrow_distance(CollisionData& data, const fcl::CollisionGeometryd* g1,
                        const fcl::Transform3d& t1, const fcl::CollisionGeometryd* g2,
                        const fcl::Transform3d& t2) {
   if (narrow_collide(g1, t1, g2, t2)) return 0;
-  data.distance_result.clear();
-  const double d = fcl::distance(g1, t1, g2, t2, data.distance_request, data.distance_result);
+  data.scratch->distance_result.clear();
+  const double d =
+      fcl::distance(g1, t1, g2, t2, data.scratch->distance_request, data.scratch->distance_result);
   return std::max(0.0, d);
 }
 
 // Signed distance of two capsules by FCL's closed-form segment-segment routine: much cheaper
 // than the generic GJK path, and most robot shapes are capsules.
-double capsule_distance(const CollisionModel& model, const CollisionData& data, int a, int b) {
+double capsule_distance(const CollisionShapes& shapes, const CollisionData& data, int a, int b) {
   double dist = 0;
   Eigen::Vector3d pa, pb;
-  fcl::detail::capsuleCapsuleDistance(*model.robot[a].capsule, data.transform[a],
-                                      *model.robot[b].capsule, data.transform[b], &dist, &pa, &pb);
+  fcl::detail::capsuleCapsuleDistance(*shapes.capsule[a], data.transform[a], *shapes.capsule[b],
+                                      data.transform[b], &dist, &pa, &pb);
   return dist;
 }
 
-bool self_collides(const CollisionModel& model, CollisionData& data, int a, int b) {
-  if (!spheres_may_touch(data, model, a, b, model.margin)) return false;
-  if (model.robot[a].capsule && model.robot[b].capsule) {
-    return capsule_distance(model, data, a, b) < model.margin;
-  }
-  return narrow_collide(model.robot[a].inflated.get(), data.transform[a],
-                        model.robot[b].exact.get(), data.transform[b]);
+// The pair tests take the shapes from the caller, which loads model.shapes once per query.
+bool self_collides(const CollisionShapes& shapes, const CollisionData& data, int a, int b) {
+  const double margin = shapes.margin;
+  if (!spheres_may_touch(data, shapes, a, b, margin)) return false;
+  const CollisionShapes::Robot& sa = shapes.robot[a];
+  const CollisionShapes::Robot& sb = shapes.robot[b];
+  if (shapes.capsule[a] && shapes.capsule[b]) return capsule_distance(shapes, data, a, b) < margin;
+  return narrow_collide(sa.inflated, data.transform[a], sb.exact, data.transform[b]);
 }
 
-bool env_collides(const CollisionModel& model, CollisionData& data, int a, int o) {
-  const CollisionModel::ObstacleShape& obstacle = model.obstacles[o];
-  if (!sphere_may_touch_box(data.sphere_centre[a], model.robot[a].sphere_radius + model.margin,
-                            obstacle)) {
-    return false;
-  }
-  return narrow_collide(model.robot[a].inflated.get(), data.transform[a], obstacle.geometry.get(),
-                        obstacle.transform);
+bool env_collides(const CollisionShapes& shapes, const CollisionData& data, int a, int o) {
+  const CollisionShapes::Robot& robot = shapes.robot[a];
+  const CollisionShapes::Obstacle& obstacle = shapes.obstacles[o];
+  if (!sphere_may_touch_box(data.sphere_centre[a], shapes.env_radius[a], obstacle)) return false;
+  return narrow_collide(robot.inflated, data.transform[a], obstacle.geometry, obstacle.transform);
 }
 
 }  // namespace
@@ -131,32 +140,44 @@ bool env_collides(const CollisionModel& model, CollisionData& data, int a, int o
 CollisionModel build_collision_model(const RobotModel& robot, const Environment& env,
                                      const CollisionOptions& options) {
   CollisionModel model;
+  auto shapes = std::make_shared<CollisionShapes>();
   model.margin = robot.collision_margin;
+  shapes->margin = model.margin;
   for (const CollisionBody& cb : robot.collision_bodies) {
     CollisionModel::RobotShape s;
     s.name = cb.name;
     s.link = cb.link;
     s.body = robot.links[cb.link].body;
     s.in_body = robot.links[cb.link].in_body * cb.in_link;
-    s.exact = make_geometry(cb.shape, 0);
-    s.inflated = make_geometry(cb.shape, model.margin);
-    if (cb.shape.type == ShapeType::Capsule)
-      s.capsule = static_cast<const fcl::Capsuled*>(s.exact.get());
     s.sphere_radius = bounding_radius(cb.shape);
+    CollisionShapes::Robot g;
+    g.exact = own(*shapes, make_geometry(cb.shape, 0));
+    g.inflated = own(*shapes, make_geometry(cb.shape, model.margin));
+    g.sphere_radius = s.sphere_radius;
     model.robot.push_back(s);
+    shapes->robot.push_back(g);
+    shapes->env_radius.push_back(s.sphere_radius + model.margin);
+    shapes->capsule.push_back(
+        cb.shape.type == ShapeType::Capsule ? static_cast<const fcl::Capsuled*>(g.exact) : nullptr);
   }
   for (const Obstacle& o : env.obstacles) {
     CollisionModel::ObstacleShape s;
     s.name = o.name;
     s.pose = o.pose;
     s.transform = to_fcl(o.pose);
-    s.geometry = make_geometry(o.shape, 0);
     // World box around the obstacle's local bounding box (tight for axis-aligned obstacles).
     const Eigen::Vector3d half = o.pose.R.cwiseAbs() * bounding_half_extents(o.shape);
     s.box_min = o.pose.p - half;
     s.box_max = o.pose.p + half;
     model.obstacles.push_back(s);
+    CollisionShapes::Obstacle g;
+    g.box_min = s.box_min;
+    g.box_max = s.box_max;
+    g.transform = s.transform;
+    g.geometry = own(*shapes, make_geometry(o.shape, 0));
+    shapes->obstacles.push_back(g);
   }
+  model.shapes = std::move(shapes);
   const int n = static_cast<int>(model.robot.size());
   for (int a = 0; a < n; ++a) {
     for (int b = a + 1; b < n; ++b) {
@@ -186,10 +207,23 @@ CollisionModel build_collision_model(const RobotModel& robot, const Environment&
 }
 
 CollisionData::CollisionData(const CollisionModel& model)
-    : transform(model.robot.size(), fcl::Transform3d::Identity()),
-      sphere_centre(model.robot.size(), Eigen::Vector3d::Zero()) {
-  distance_request.gjk_solver_type = fcl::GST_INDEP;
+    : transform(model.robot.size(), Eigen::Isometry3d::Identity()),
+      sphere_centre(model.robot.size(), Eigen::Vector3d::Zero()),
+      scratch(std::make_unique<CollisionScratch>()) {
+  scratch->distance_request.gjk_solver_type = fcl::GST_INDEP;
 }
+
+CollisionData::~CollisionData() = default;
+CollisionData::CollisionData(const CollisionData& other)
+    : transform(other.transform),
+      sphere_centre(other.sphere_centre),
+      scratch(other.scratch ? std::make_unique<CollisionScratch>(*other.scratch) : nullptr) {}
+CollisionData& CollisionData::operator=(const CollisionData& other) {
+  if (this != &other) *this = CollisionData(other);
+  return *this;
+}
+CollisionData::CollisionData(CollisionData&&) noexcept = default;
+CollisionData& CollisionData::operator=(CollisionData&&) noexcept = default;
 
 void update_collision_transforms(const CollisionModel& model, CollisionData& data,
                                  const RobotData& robot_data) {
@@ -203,19 +237,21 @@ void update_collision_transforms(const CollisionModel& model, CollisionData& dat
 }
 
 bool in_collision(const CollisionModel& model, CollisionData& data) {
+  const CollisionShapes& shapes = *model.shapes;
   for (const auto& [a, o] : model.env_pairs) {
-    if (env_collides(model, data, a, o)) return true;
+    if (env_collides(shapes, data, a, o)) return true;
   }
   for (const auto& [a, b] : model.self_pairs) {
-    if (self_collides(model, data, a, b)) return true;
+    if (self_collides(shapes, data, a, b)) return true;
   }
   return false;
 }
 
 CollisionReport check_collision(const CollisionModel& model, CollisionData& data) {
+  const CollisionShapes& shapes = *model.shapes;
   CollisionReport report;
   for (const auto& [a, o] : model.env_pairs) {
-    if (env_collides(model, data, a, o)) {
+    if (env_collides(shapes, data, a, o)) {
       report.env_collision = true;
       report.first_a = a;
       report.first_b = o;
@@ -223,7 +259,7 @@ CollisionReport check_collision(const CollisionModel& model, CollisionData& data
     }
   }
   for (const auto& [a, b] : model.self_pairs) {
-    if (self_collides(model, data, a, b)) {
+    if (self_collides(shapes, data, a, b)) {
       report.self_collision = true;
       if (report.first_a < 0) {
         report.first_a = a;
@@ -238,27 +274,29 @@ CollisionReport check_collision(const CollisionModel& model, CollisionData& data
 DistanceReport min_distance(const CollisionModel& model, CollisionData& data) {
   DistanceReport report;
   for (const auto& [a, o] : model.env_pairs) {
-    report.env_distance =
-        std::min(report.env_distance,
-                 narrow_distance(data, model.robot[a].exact.get(), data.transform[a],
-                                 model.obstacles[o].geometry.get(), model.obstacles[o].transform));
+    report.env_distance = std::min(
+        report.env_distance,
+        narrow_distance(data, model.shapes->robot[a].exact, data.transform[a],
+                        model.shapes->obstacles[o].geometry, model.obstacles[o].transform));
   }
   for (const auto& [a, b] : model.self_pairs) {
-    if (model.robot[a].capsule && model.robot[b].capsule) {
-      report.self_distance =
-          std::min(report.self_distance, std::max(0.0, capsule_distance(model, data, a, b)));
+    const CollisionShapes::Robot& sa = model.shapes->robot[a];
+    const CollisionShapes::Robot& sb = model.shapes->robot[b];
+    if (model.shapes->capsule[a] && model.shapes->capsule[b]) {
+      report.self_distance = std::min(report.self_distance,
+                                      std::max(0.0, capsule_distance(*model.shapes, data, a, b)));
       continue;
     }
-    report.self_distance = std::min(
-        report.self_distance, narrow_distance(data, model.robot[a].exact.get(), data.transform[a],
-                                              model.robot[b].exact.get(), data.transform[b]));
+    report.self_distance =
+        std::min(report.self_distance,
+                 narrow_distance(data, sa.exact, data.transform[a], sb.exact, data.transform[b]));
   }
   return report;
 }
 
 bool self_pair_collides(const CollisionModel& model, CollisionData& data, int shape_a,
                         int shape_b) {
-  return self_collides(model, data, shape_a, shape_b);
+  return self_collides(*model.shapes, data, shape_a, shape_b);
 }
 
 }  // namespace lazyboe

@@ -8,10 +8,12 @@
 // spheres and capsules and conservative for boxes and cylinders.
 #pragma once
 
-#include <fcl/fcl.h>
-
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <limits>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "lazyboe/collision/environment.h"
@@ -19,29 +21,32 @@
 
 namespace lazyboe {
 
+// The FCL shapes and query state, defined in the library's private fcl_shapes.h.
+struct CollisionShapes;
+struct CollisionScratch;
+
+// Transforms are Eigen::Isometry3d, which is fcl::Transform3d: FCL takes them as they are.
 struct CollisionModel {
   struct RobotShape {
     std::string name;
     int link = 0;
     int body = -1;  // -1: fixed to the base
     Pose in_body;
-    std::shared_ptr<fcl::CollisionGeometryd> exact, inflated;
-    const fcl::Capsuled* capsule = nullptr;  // the exact shape, when it is a capsule
     double sphere_radius = 0;  // bounding sphere about the shape's origin (exact shape)
   };
   struct ObstacleShape {
     std::string name;
-    fcl::Transform3d transform;
+    Eigen::Isometry3d transform;
     Pose pose;
-    std::shared_ptr<fcl::CollisionGeometryd> geometry;
     Eigen::Vector3d box_min, box_max;  // axis-aligned bounding box in the base frame
   };
 
   double margin = 0;
   std::vector<RobotShape> robot;
   std::vector<ObstacleShape> obstacles;
-  std::vector<std::pair<int, int>> self_pairs;  // robot shape indices
-  std::vector<std::pair<int, int>> env_pairs;   // (robot shape, obstacle)
+  std::vector<std::pair<int, int>> self_pairs;    // robot shape indices
+  std::vector<std::pair<int, int>> env_pairs;     // (robot shape, obstacle)
+  std::shared_ptr<const CollisionShapes> shapes;  // FCL geometry of robot and obstacles
 };
 
 struct CollisionOptions {
@@ -55,10 +60,15 @@ CollisionModel build_collision_model(const RobotModel& robot, const Environment&
 // Per-thread scratch.
 struct CollisionData {
   explicit CollisionData(const CollisionModel& model);
-  std::vector<fcl::Transform3d> transform;     // robot shapes in the base frame
+  ~CollisionData();
+  CollisionData(const CollisionData& other);
+  CollisionData& operator=(const CollisionData& other);
+  CollisionData(CollisionData&&) noexcept;
+  CollisionData& operator=(CollisionData&&) noexcept;
+
+  std::vector<Eigen::Isometry3d> transform;    // robot shapes in the base frame
   std::vector<Eigen::Vector3d> sphere_centre;  // bounding-sphere centres in the base frame
-  fcl::DistanceRequestd distance_request;
-  fcl::DistanceResultd distance_result;
+  std::unique_ptr<CollisionScratch> scratch;   // FCL state of min_distance
 };
 
 struct CollisionReport {

@@ -1,7 +1,5 @@
 #include "lazyboe/io/csv.h"
 
-#include <unistd.h>
-
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -93,34 +91,21 @@ CsvTable read_numeric_csv(const std::string& path,
 }
 
 CsvWriter::CsvWriter(const std::string& path, const std::vector<std::string>& header)
-    : path_(path), tmp_path_(path + ".tmp." + std::to_string(::getpid())), columns_(header.size()) {
-  file_ = std::fopen(tmp_path_.c_str(), "w");
-  if (!file_) fail(path, std::string("cannot write: ") + std::strerror(errno));
-  std::fprintf(file_, "%s\n", join(header).c_str());
-}
-
-CsvWriter::~CsvWriter() {
-  if (file_) {  // not committed: drop the partial file
-    std::fclose(file_);
-    std::remove(tmp_path_.c_str());
-  }
+    : file_(path), columns_(header.size()) {
+  file_.stream() << join(header) << '\n';
 }
 
 void CsvWriter::row(const std::vector<double>& values) {
-  if (values.size() != columns_) fail(path_, "internal error: row width differs from header");
+  if (values.size() != columns_)
+    fail(file_.path(), "internal error: row width differs from header");
+  std::ostream& out = file_.stream();
+  char cell[32];
   for (size_t i = 0; i < values.size(); ++i) {
-    std::fprintf(file_, i + 1 < values.size() ? "%.10g," : "%.10g\n", values[i]);
+    std::snprintf(cell, sizeof cell, "%.10g", values[i]);
+    out << cell << (i + 1 < values.size() ? ',' : '\n');
   }
 }
 
-void CsvWriter::commit() {
-  const bool ok = std::fflush(file_) == 0 && ::fsync(fileno(file_)) == 0;
-  std::fclose(file_);
-  file_ = nullptr;
-  if (!ok || std::rename(tmp_path_.c_str(), path_.c_str()) != 0) {
-    std::remove(tmp_path_.c_str());
-    fail(path_, std::string("cannot write: ") + std::strerror(errno));
-  }
-}
+void CsvWriter::commit() { file_.commit(); }
 
 }  // namespace lazyboe

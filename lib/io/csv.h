@@ -2,9 +2,10 @@
 // checked: a wrong column count, text, NaN or infinity is an error naming file, line and column.
 #pragma once
 
-#include <cstdio>
 #include <string>
 #include <vector>
+
+#include "lazyboe/common/atomic_file.h"
 
 namespace lazyboe {
 
@@ -24,15 +25,11 @@ std::vector<std::string> numbered_columns(const std::string& prefix, int n);
 class CsvWriter {
  public:
   CsvWriter(const std::string& path, const std::vector<std::string>& header);
-  ~CsvWriter();
-  CsvWriter(const CsvWriter&) = delete;
-  CsvWriter& operator=(const CsvWriter&) = delete;
   void row(const std::vector<double>& values);
-  void commit();  // flush and rename into place
+  void commit();  // flush and rename into place (uncommitted: the partial file is dropped)
 
  private:
-  std::string path_, tmp_path_;
-  std::FILE* file_ = nullptr;
+  AtomicFile file_;
   size_t columns_;
 };
 

@@ -8,8 +8,9 @@
 #include <chrono>
 #include <string>
 
-#include "lazyboe/bundle/builder.h"
 #include "lazyboe/bundle/bundle_view.h"
+#include "lazyboe/bundle/scene.h"
+#include "lazyboe/bundle/settings.h"
 #include "lazyboe/collision/collision_model.h"
 #include "lazyboe/planning/neighbour_index.h"
 #include "lazyboe/planning/planner.h"

@@ -266,6 +266,234 @@ std::string data_dir() {
 
 std::string default_robot_path() { return data_dir() + "/robots/panda.json"; }
 
+namespace {
+
+// The chain: from base_link (default: the URDF root) to tip_link (default: follow the only
+// child until the tree ends). `base_name` receives the base link's name.
+std::vector<urdf::LinkConstSharedPtr> find_chain(const JsonField& root,
+                                                 const urdf::ModelInterface& urdf_model,
+                                                 const std::string& upath,
+                                                 const std::string& config_path,
+                                                 std::string& base_name) {
+  base_name = root.has("base_link") ? root.at("base_link").string() : urdf_model.getRoot()->name;
+  urdf::LinkConstSharedPtr base = urdf_model.getLink(base_name);
+  if (!base) root.at("base_link").fail("no link '" + base_name + "' in " + upath);
+  std::vector<urdf::LinkConstSharedPtr> chain;  // base ... tip
+  if (root.has("tip_link")) {
+    const std::string tip_name = root.at("tip_link").string();
+    urdf::LinkConstSharedPtr link = urdf_model.getLink(tip_name);
+    if (!link) root.at("tip_link").fail("no link '" + tip_name + "' in " + upath);
+    while (link && link != base) {
+      chain.push_back(link);
+      link = link->getParent();
+    }
+    if (!link) root.at("tip_link").fail("'" + tip_name + "' is not below '" + base_name + "'");
+    chain.push_back(base);
+    std::reverse(chain.begin(), chain.end());
+  } else {
+    urdf::LinkConstSharedPtr link = base;
+    chain.push_back(link);
+    while (!link->child_links.empty()) {
+      if (link->child_links.size() > 1) {
+        fail(config_path,
+             "the URDF branches at link '" + link->name + "'; set tip_link to choose the chain");
+      }
+      link = link->child_links[0];
+      chain.push_back(link);
+    }
+  }
+  return chain;
+}
+
+// A moving joint of the chain; `origin` is its frame in the parent body.
+Joint joint_from_urdf(const urdf::Joint& uj, const Pose& origin, const std::string& where) {
+  Joint j;
+  j.name = uj.name;
+  j.type = uj.type == urdf::Joint::REVOLUTE ? JointType::Revolute : JointType::Prismatic;
+  j.origin = origin;
+  j.axis = Eigen::Vector3d(uj.axis.x, uj.axis.y, uj.axis.z);
+  if (!(j.axis.norm() > 1e-9)) fail(where, "axis must not be zero");
+  j.axis.normalize();
+  j.axis_is_z = (j.axis - Eigen::Vector3d::UnitZ()).norm() < 1e-15;
+  if (!uj.limits) fail(where, "missing <limit>");
+  j.lower = uj.limits->lower;
+  j.upper = uj.limits->upper;
+  j.max_velocity = uj.limits->velocity;
+  j.max_effort = uj.limits->effort;
+  if (!(std::isfinite(j.lower) && std::isfinite(j.upper) && j.lower < j.upper)) {
+    fail(where, "position limits must satisfy lower < upper");
+  }
+  if (!(j.max_velocity > 0)) fail(where, "velocity limit must be > 0");
+  if (!(j.max_effort > 0)) fail(where, "effort limit must be > 0");
+  return j;
+}
+
+// Walks the chain: a moving joint starts a new body; fixed joints merge into the current one.
+// Links hanging off the chain through fixed joints join their body too. Returns the URDF link
+// of every model link.
+std::vector<urdf::LinkConstSharedPtr> build_bodies(
+    RobotModel& model, const std::vector<urdf::LinkConstSharedPtr>& chain,
+    const std::string& upath) {
+  std::set<std::string> on_chain;
+  for (const auto& l : chain) on_chain.insert(l->name);
+  int body = -1;
+  std::vector<urdf::LinkConstSharedPtr> link_sources;
+  std::function<void(const urdf::LinkConstSharedPtr&, const Pose&)> add_link =
+      [&](const urdf::LinkConstSharedPtr& link, const Pose& in_body) {
+        check_inertial(upath, *link);
+        model.links.push_back({link->name, body, in_body});
+        link_sources.push_back(link);
+        if (body >= 0 && link->inertial) {
+          const Pose inertial = in_body * pose_from_urdf(link->inertial->origin);
+          Eigen::Matrix3d I;
+          const urdf::Inertial& in = *link->inertial;
+          I << in.ixx, in.ixy, in.ixz, in.ixy, in.iyy, in.iyz, in.ixz, in.iyz, in.izz;
+          merge_inertia(model.bodies[body], in.mass, inertial.p,
+                        inertial.R * I * inertial.R.transpose());
+        }
+        for (const auto& child : link->child_links) {
+          if (on_chain.count(child->name)) continue;
+          const urdf::Joint& j = *child->parent_joint;
+          if (j.type == urdf::Joint::FIXED) {
+            add_link(child, in_body * pose_from_urdf(j.parent_to_joint_origin_transform));
+          } else {
+            model.ignored_links.push_back(child->name);
+          }
+        }
+      };
+  Pose in_body;  // current chain link in the current body frame
+  for (size_t k = 0; k < chain.size(); ++k) {
+    const urdf::LinkConstSharedPtr& link = chain[k];
+    if (k > 0) {
+      const urdf::Joint& uj = *link->parent_joint;
+      const Pose origin = in_body * pose_from_urdf(uj.parent_to_joint_origin_transform);
+      const std::string where = upath + ": joint '" + uj.name + "'";
+      if (uj.type == urdf::Joint::FIXED) {
+        in_body = origin;
+      } else if (uj.type == urdf::Joint::REVOLUTE || uj.type == urdf::Joint::PRISMATIC) {
+        if (model.dof >= kMaxDof) {
+          fail(where, "chain has more than " + std::to_string(kMaxDof) + " moving joints");
+        }
+        model.joints.push_back(joint_from_urdf(uj, origin, where));
+        model.bodies.emplace_back();
+        body = model.dof++;
+        in_body = Pose();
+      } else {
+        fail(where, "only revolute, prismatic and fixed joints are supported");
+      }
+    }
+    add_link(link, in_body);
+  }
+  return link_sources;
+}
+
+void read_controller(RobotModel& model, const JsonField& root) {
+  if (!root.has("controller")) return;
+  const JsonField c = root.at("controller");
+  c.allow_only({"type", "description", "kv", "ka", "friction_feedforward"});
+  if (c.at("type").string() != "velocity_tracking") {
+    c.at("type").fail("unknown controller (expected velocity_tracking)");
+  }
+  for (auto [key, gains] : {std::pair<const char*, JointVector*>{"kv", &model.controller.kv},
+                            std::pair<const char*, JointVector*>{"ka", &model.controller.ka}}) {
+    const std::vector<JsonField> items = c.at(key).items();
+    if (static_cast<int>(items.size()) != model.dof) {
+      c.at(key).fail("expected " + std::to_string(model.dof) + " gains, one per moving joint");
+    }
+    gains->resize(model.dof);
+    for (int i = 0; i < model.dof; ++i) (*gains)[i] = items[i].number_at_least(0);
+  }
+  if (c.has("friction_feedforward")) {
+    model.controller.friction_feedforward = c.at("friction_feedforward").boolean();
+  }
+  model.controller.present = true;
+}
+
+void read_collision(RobotModel& model, const JsonField& root, const std::string& upath,
+                    const std::vector<urdf::LinkConstSharedPtr>& link_sources) {
+  const JsonField collision = root.at("collision");
+  collision.allow_only({"margin", "allowed_pairs"});
+  model.collision_margin = collision.at("margin").number_at_least(0);
+  for (size_t i = 0; i < model.links.size(); ++i) {
+    add_collision_bodies(model, upath, *link_sources[i], static_cast<int>(i));
+  }
+  if (!collision.has("allowed_pairs")) return;
+  for (const JsonField& pair : collision.at("allowed_pairs").items()) {
+    std::vector<JsonField> names = pair.items();
+    if (names.size() != 2) pair.fail("expected two link names");
+    int idx[2];
+    for (int k = 0; k < 2; ++k) {
+      const std::string n = names[k].string();
+      idx[k] = model.link_index(n);
+      if (idx[k] < 0) names[k].fail("unknown link '" + n + "'");
+    }
+    if (idx[0] == idx[1]) pair.fail("a pair needs two different links");
+    model.allowed_pairs.emplace_back(std::min(idx[0], idx[1]), std::max(idx[0], idx[1]));
+  }
+  std::sort(model.allowed_pairs.begin(), model.allowed_pairs.end());
+  model.allowed_pairs.erase(std::unique(model.allowed_pairs.begin(), model.allowed_pairs.end()),
+                            model.allowed_pairs.end());
+}
+
+// The per-joint limit vectors, from the joints.
+void fill_limits(RobotModel& model) {
+  const int n = model.dof;
+  for (JointVector* v : {&model.q_min, &model.q_max, &model.dq_max, &model.ddq_max, &model.dddq_max,
+                         &model.tau_max, &model.dtau_max}) {
+    v->resize(n);
+  }
+  for (int i = 0; i < n; ++i) {
+    const Joint& j = model.joints[i];
+    model.q_min[i] = j.lower;
+    model.q_max[i] = j.upper;
+    model.dq_max[i] = j.max_velocity;
+    model.ddq_max[i] = j.max_acceleration;
+    model.dddq_max[i] = j.max_jerk;
+    model.tau_max[i] = j.max_effort;
+    model.dtau_max[i] = j.max_torque_rate;
+  }
+}
+
+// The sampling region (default: the joint limits).
+void read_sampling_region(RobotModel& model, const JsonField& root) {
+  const int n = model.dof;
+  model.region_lower = model.q_min;
+  model.region_upper = model.q_max;
+  if (!root.has("sampling_region")) return;
+  const JsonField region = root.at("sampling_region");
+  region.allow_only({"description", "lower", "upper"});
+  for (auto [key, bound] : {std::pair<const char*, JointVector*>{"lower", &model.region_lower},
+                            std::pair<const char*, JointVector*>{"upper", &model.region_upper}}) {
+    const std::vector<double> v = region.at(key).numbers();
+    if (static_cast<int>(v.size()) != n) {
+      region.at(key).fail("expected " + std::to_string(n) + " values, one per moving joint");
+    }
+    for (int i = 0; i < n; ++i) (*bound)[i] = v[i];
+  }
+  for (int i = 0; i < n; ++i) {
+    if (!(model.region_lower[i] < model.region_upper[i])) {
+      region.fail("joint " + std::to_string(i + 1) + ": lower must be below upper");
+    }
+    if (model.region_lower[i] < model.q_min[i] || model.region_upper[i] > model.q_max[i]) {
+      region.fail("joint " + std::to_string(i + 1) + ": outside the joint limits");
+    }
+  }
+}
+
+// A chain whose mass matrix is singular (a moving body with no mass or inertia about its
+// axis) cannot be simulated; say so now rather than produce NaNs later.
+void check_mass_matrix(const RobotModel& model, const std::string& upath) {
+  RobotData data(model);
+  const JointVector mid = (model.q_min + model.q_max) / 2;
+  const JointMatrix& M = mass_matrix(model, data, mid);
+  Eigen::SelfAdjointEigenSolver<JointMatrix> eig(M);
+  if (!(eig.eigenvalues().minCoeff() > 1e-12)) {
+    fail(upath, "the mass matrix is singular: a moving body has no mass or inertia");
+  }
+}
+
+}  // namespace
+
 RobotModel load_robot(const std::string& config_path) {
   const nlohmann::json config = load_json_file(config_path);
   const JsonField root(config, config_path, "");
@@ -290,207 +518,18 @@ RobotModel load_robot(const std::string& config_path) {
 
   const urdf::ModelInterfaceSharedPtr urdf_model = parse_urdf_file(model.urdf_path);
   const std::string& upath = model.urdf_path;
-
-  // The chain: from base_link (default: the URDF root) to tip_link (default: follow the only
-  // child until the tree ends).
-  const std::string base_name =
-      root.has("base_link") ? root.at("base_link").string() : urdf_model->getRoot()->name;
-  urdf::LinkConstSharedPtr base = urdf_model->getLink(base_name);
-  if (!base) root.at("base_link").fail("no link '" + base_name + "' in " + upath);
-  std::vector<urdf::LinkConstSharedPtr> chain;  // base ... tip
-  if (root.has("tip_link")) {
-    const std::string tip_name = root.at("tip_link").string();
-    urdf::LinkConstSharedPtr link = urdf_model->getLink(tip_name);
-    if (!link) root.at("tip_link").fail("no link '" + tip_name + "' in " + upath);
-    while (link && link != base) {
-      chain.push_back(link);
-      link = link->getParent();
-    }
-    if (!link) root.at("tip_link").fail("'" + tip_name + "' is not below '" + base_name + "'");
-    chain.push_back(base);
-    std::reverse(chain.begin(), chain.end());
-  } else {
-    urdf::LinkConstSharedPtr link = base;
-    chain.push_back(link);
-    while (!link->child_links.empty()) {
-      if (link->child_links.size() > 1) {
-        fail(config_path,
-             "the URDF branches at link '" + link->name + "'; set tip_link to choose the chain");
-      }
-      link = link->child_links[0];
-      chain.push_back(link);
-    }
-  }
-
-  // Walk the chain: a moving joint starts a new body; fixed joints merge into the current one.
-  // Links hanging off the chain through fixed joints join their body too.
-  std::set<std::string> on_chain;
-  for (const auto& l : chain) on_chain.insert(l->name);
-  int body = -1;
-  std::vector<urdf::LinkConstSharedPtr> link_sources;
-  std::function<void(const urdf::LinkConstSharedPtr&, const Pose&)> add_link =
-      [&](const urdf::LinkConstSharedPtr& link, const Pose& in_body) {
-        check_inertial(upath, *link);
-        const int index = static_cast<int>(model.links.size());
-        model.links.push_back({link->name, body, in_body});
-        link_sources.push_back(link);
-        if (body >= 0 && link->inertial) {
-          const Pose inertial = in_body * pose_from_urdf(link->inertial->origin);
-          Eigen::Matrix3d I;
-          const urdf::Inertial& in = *link->inertial;
-          I << in.ixx, in.ixy, in.ixz, in.ixy, in.iyy, in.iyz, in.ixz, in.iyz, in.izz;
-          merge_inertia(model.bodies[body], in.mass, inertial.p,
-                        inertial.R * I * inertial.R.transpose());
-        }
-        (void)index;
-        for (const auto& child : link->child_links) {
-          if (on_chain.count(child->name)) continue;
-          const urdf::Joint& j = *child->parent_joint;
-          if (j.type == urdf::Joint::FIXED) {
-            add_link(child, in_body * pose_from_urdf(j.parent_to_joint_origin_transform));
-          } else {
-            model.ignored_links.push_back(child->name);
-          }
-        }
-      };
-  Pose in_body;  // current chain link in the current body frame
-  for (size_t k = 0; k < chain.size(); ++k) {
-    const urdf::LinkConstSharedPtr& link = chain[k];
-    if (k > 0) {
-      const urdf::Joint& uj = *link->parent_joint;
-      const Pose origin = in_body * pose_from_urdf(uj.parent_to_joint_origin_transform);
-      const std::string where = upath + ": joint '" + uj.name + "'";
-      if (uj.type == urdf::Joint::FIXED) {
-        in_body = origin;
-      } else if (uj.type == urdf::Joint::REVOLUTE || uj.type == urdf::Joint::PRISMATIC) {
-        if (model.dof >= kMaxDof) {
-          fail(where, "chain has more than " + std::to_string(kMaxDof) + " moving joints");
-        }
-        Joint j;
-        j.name = uj.name;
-        j.type = uj.type == urdf::Joint::REVOLUTE ? JointType::Revolute : JointType::Prismatic;
-        j.origin = origin;
-        j.axis = Eigen::Vector3d(uj.axis.x, uj.axis.y, uj.axis.z);
-        if (!(j.axis.norm() > 1e-9)) fail(where, "axis must not be zero");
-        j.axis.normalize();
-        j.axis_is_z = (j.axis - Eigen::Vector3d::UnitZ()).norm() < 1e-15;
-        if (!uj.limits) fail(where, "missing <limit>");
-        j.lower = uj.limits->lower;
-        j.upper = uj.limits->upper;
-        j.max_velocity = uj.limits->velocity;
-        j.max_effort = uj.limits->effort;
-        if (!(std::isfinite(j.lower) && std::isfinite(j.upper) && j.lower < j.upper)) {
-          fail(where, "position limits must satisfy lower < upper");
-        }
-        if (!(j.max_velocity > 0)) fail(where, "velocity limit must be > 0");
-        if (!(j.max_effort > 0)) fail(where, "effort limit must be > 0");
-        model.joints.push_back(j);
-        model.bodies.emplace_back();
-        body = model.dof++;
-        in_body = Pose();
-      } else {
-        fail(where, "only revolute, prismatic and fixed joints are supported");
-      }
-    }
-    add_link(link, in_body);
-  }
+  std::string base_name;
+  const std::vector<urdf::LinkConstSharedPtr> chain =
+      find_chain(root, *urdf_model, upath, config_path, base_name);
+  const std::vector<urdf::LinkConstSharedPtr> link_sources = build_bodies(model, chain, upath);
   if (model.dof == 0) fail(upath, "the chain from '" + base_name + "' has no moving joint");
 
   read_config_joints(model, root);
-
-  if (root.has("controller")) {
-    const JsonField c = root.at("controller");
-    c.allow_only({"type", "description", "kv", "ka", "friction_feedforward"});
-    if (c.at("type").string() != "velocity_tracking") {
-      c.at("type").fail("unknown controller (expected velocity_tracking)");
-    }
-    for (auto [key, gains] : {std::pair<const char*, JointVector*>{"kv", &model.controller.kv},
-                              std::pair<const char*, JointVector*>{"ka", &model.controller.ka}}) {
-      const std::vector<JsonField> items = c.at(key).items();
-      if (static_cast<int>(items.size()) != model.dof) {
-        c.at(key).fail("expected " + std::to_string(model.dof) + " gains, one per moving joint");
-      }
-      gains->resize(model.dof);
-      for (int i = 0; i < model.dof; ++i) (*gains)[i] = items[i].number_at_least(0);
-    }
-    if (c.has("friction_feedforward")) {
-      model.controller.friction_feedforward = c.at("friction_feedforward").boolean();
-    }
-    model.controller.present = true;
-  }
-
-  const JsonField collision = root.at("collision");
-  collision.allow_only({"margin", "allowed_pairs"});
-  model.collision_margin = collision.at("margin").number_at_least(0);
-  for (size_t i = 0; i < model.links.size(); ++i) {
-    add_collision_bodies(model, upath, *link_sources[i], static_cast<int>(i));
-  }
-  if (collision.has("allowed_pairs")) {
-    for (const JsonField& pair : collision.at("allowed_pairs").items()) {
-      std::vector<JsonField> names = pair.items();
-      if (names.size() != 2) pair.fail("expected two link names");
-      int idx[2];
-      for (int k = 0; k < 2; ++k) {
-        const std::string n = names[k].string();
-        idx[k] = model.link_index(n);
-        if (idx[k] < 0) names[k].fail("unknown link '" + n + "'");
-      }
-      if (idx[0] == idx[1]) pair.fail("a pair needs two different links");
-      model.allowed_pairs.emplace_back(std::min(idx[0], idx[1]), std::max(idx[0], idx[1]));
-    }
-    std::sort(model.allowed_pairs.begin(), model.allowed_pairs.end());
-    model.allowed_pairs.erase(std::unique(model.allowed_pairs.begin(), model.allowed_pairs.end()),
-                              model.allowed_pairs.end());
-  }
-
-  const int n = model.dof;
-  for (JointVector* v : {&model.q_min, &model.q_max, &model.dq_max, &model.ddq_max, &model.dddq_max,
-                         &model.tau_max, &model.dtau_max}) {
-    v->resize(n);
-  }
-  for (int i = 0; i < n; ++i) {
-    const Joint& j = model.joints[i];
-    model.q_min[i] = j.lower;
-    model.q_max[i] = j.upper;
-    model.dq_max[i] = j.max_velocity;
-    model.ddq_max[i] = j.max_acceleration;
-    model.dddq_max[i] = j.max_jerk;
-    model.tau_max[i] = j.max_effort;
-    model.dtau_max[i] = j.max_torque_rate;
-  }
-
-  model.region_lower = model.q_min;
-  model.region_upper = model.q_max;
-  if (root.has("sampling_region")) {
-    const JsonField region = root.at("sampling_region");
-    region.allow_only({"description", "lower", "upper"});
-    for (auto [key, bound] : {std::pair<const char*, JointVector*>{"lower", &model.region_lower},
-                              std::pair<const char*, JointVector*>{"upper", &model.region_upper}}) {
-      const std::vector<double> v = region.at(key).numbers();
-      if (static_cast<int>(v.size()) != n) {
-        region.at(key).fail("expected " + std::to_string(n) + " values, one per moving joint");
-      }
-      for (int i = 0; i < n; ++i) (*bound)[i] = v[i];
-    }
-    for (int i = 0; i < n; ++i) {
-      if (!(model.region_lower[i] < model.region_upper[i])) {
-        region.fail("joint " + std::to_string(i + 1) + ": lower must be below upper");
-      }
-      if (model.region_lower[i] < model.q_min[i] || model.region_upper[i] > model.q_max[i]) {
-        region.fail("joint " + std::to_string(i + 1) + ": outside the joint limits");
-      }
-    }
-  }
-
-  // A chain whose mass matrix is singular (a moving body with no mass or inertia about its
-  // axis) cannot be simulated; say so now rather than produce NaNs later.
-  RobotData data(model);
-  const JointVector mid = (model.q_min + model.q_max) / 2;
-  const JointMatrix& M = mass_matrix(model, data, mid);
-  Eigen::SelfAdjointEigenSolver<JointMatrix> eig(M);
-  if (!(eig.eigenvalues().minCoeff() > 1e-12)) {
-    fail(upath, "the mass matrix is singular: a moving body has no mass or inertia");
-  }
+  read_controller(model, root);
+  read_collision(model, root, upath, link_sources);
+  fill_limits(model);
+  read_sampling_region(model, root);
+  check_mass_matrix(model, upath);
   return model;
 }
 

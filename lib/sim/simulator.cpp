@@ -33,6 +33,32 @@ const char* rollout_status_name(RolloutStatus status) {
   return "?";
 }
 
+const char* integrator_name(Integrator integrator) {
+  return integrator == Integrator::RK4 ? "rk4" : "euler";
+}
+
+Integrator parse_integrator(const std::string& name, const std::string& where) {
+  if (name == "euler") return Integrator::SemiImplicitEuler;
+  if (name == "rk4") return Integrator::RK4;
+  fail(where, "expected euler or rk4, got '" + name + "'");
+}
+
+int sample_every_ticks(double interval_s, double control_rate) {
+  return static_cast<int>(std::lround(interval_s * control_rate));
+}
+
+double sample_interval_seconds(int ticks, double control_rate) { return ticks / control_rate; }
+
+int exact_sample_every_ticks(double interval_s, double control_rate, const std::string& where) {
+  const int ticks = sample_every_ticks(interval_s, control_rate);
+  if (interval_s > 0 &&
+      std::abs(sample_interval_seconds(ticks, control_rate) - interval_s) > 1e-9) {
+    fail(where,
+         "must be a multiple of the control period (" + std::to_string(1 / control_rate) + " s)");
+  }
+  return ticks;
+}
+
 namespace {
 
 // r_i: a point of a shape on body b >= i is at most
@@ -113,6 +139,75 @@ void push_sample(const TrajectorySamples& samples, const JointVector& q, const J
   }
 }
 
+// Integration stages, allocated once per rollout.
+struct Stages {
+  explicit Stages(int n) : k1q(n), k1v(n), k2q(n), k2v(n), k3q(n), k3v(n), k4q(n), k4v(n) {}
+  JointVector k1q, k1v, k2q, k2v, k3q, k3v, k4q, k4v;
+};
+
+// One control period with the torque held: `substeps` steps (of h) of RK4 or semi-implicit Euler.
+// The first step reuses the dynamics terms of this tick's state; ddq is its acceleration.
+// Both helpers are inlined into simulate (they run every tick), as before they were split out.
+[[gnu::always_inline]] inline void integrate_period(const Simulator& sim, RobotData& rd,
+                                                    const JointVector& tau, double h,
+                                                    JointVector& q, JointVector& dq,
+                                                    JointVector& ddq, Stages& k) {
+  const RobotModel& robot = sim.robot;
+  for (int sub = 0; sub < sim.options.substeps; ++sub) {
+    if (sim.options.integrator == Integrator::SemiImplicitEuler) {
+      k.k1v =
+          sub == 0 ? forward_dynamics_from_terms(rd, tau) : forward_dynamics(robot, rd, q, dq, tau);
+      if (sub == 0) ddq = k.k1v;
+      dq += h * k.k1v;
+      q += h * dq;
+      continue;
+    }
+    k.k1q = dq;
+    k.k1v =
+        sub == 0 ? forward_dynamics_from_terms(rd, tau) : forward_dynamics(robot, rd, q, dq, tau);
+    if (sub == 0) ddq = k.k1v;
+    k.k2q = dq + 0.5 * h * k.k1v;
+    k.k2v = forward_dynamics(robot, rd, q + 0.5 * h * k.k1q, k.k2q, tau);
+    k.k3q = dq + 0.5 * h * k.k2v;
+    k.k3v = forward_dynamics(robot, rd, q + 0.5 * h * k.k2q, k.k3q, tau);
+    k.k4q = dq + h * k.k3v;
+    k.k4v = forward_dynamics(robot, rd, q + h * k.k3q, k.k4q, tau);
+    q += (h / 6) * (k.k1q + 2 * k.k2q + 2 * k.k3q + k.k4q);
+    dq += (h / 6) * (k.k1v + 2 * k.k2v + 2 * k.k3v + k.k4v);
+  }
+}
+
+// Collision checks spaced so that no point moves more than the margin between two: `moved`
+// bounds the path length of any point since the last check; a tick that moves too far is
+// checked in between as well (at `between`, scratch).
+[[gnu::always_inline]] inline RolloutStatus check_motion(const Simulator& sim,
+                                                         SimulatorWorkspace& ws,
+                                                         const JointVector& q_prev,
+                                                         const JointVector& q, double& moved,
+                                                         JointVector& between, int& checks) {
+  const double margin = sim.collision.margin;
+  const double step = sim.lever_arm.dot((q - q_prev).cwiseAbs());
+  if (!(moved + step > margin)) {
+    moved += step;
+    return RolloutStatus::Valid;
+  }
+  if (moved > 0) {
+    const RolloutStatus c = collision_status(sim, ws, q_prev, checks);
+    if (c != RolloutStatus::Valid) return c;
+  }
+  moved = step;
+  if (step > margin) {
+    const int pieces = static_cast<int>(std::ceil(step / margin));
+    for (int j = 1; j < pieces; ++j) {
+      between = q_prev + (static_cast<double>(j) / pieces) * (q - q_prev);
+      const RolloutStatus c = collision_status(sim, ws, between, checks);
+      if (c != RolloutStatus::Valid) return c;
+    }
+    moved = step / pieces;
+  }
+  return RolloutStatus::Valid;
+}
+
 }  // namespace
 
 RolloutResult simulate(const Simulator& sim, SimulatorWorkspace& ws, const JointVectorRef& q0_in,
@@ -121,7 +216,6 @@ RolloutResult simulate(const Simulator& sim, SimulatorWorkspace& ws, const Joint
   const ControllerGains& gains = robot.controller;
   const int n = robot.dof;
   const double dt = sim.dt, h = dt / sim.options.substeps;
-  const double margin = sim.collision.margin;
   const int sample_every = samples.every > 0 ? samples.every : sim.options.sample_every;
   RobotData& rd = ws.robot;
 
@@ -132,7 +226,8 @@ RolloutResult simulate(const Simulator& sim, SimulatorWorkspace& ws, const Joint
   // At rest before the edge, the controller holds the arm against gravity.
   JointVector tau_prev = gravity_torques(robot, rd, q0);
   JointVector ddq_prev = JointVector::Zero(n);
-  JointVector k1q(n), k1v(n), k2q(n), k2v(n), k3q(n), k3v(n), k4q(n), k4v(n), ddq(n);
+  Stages k(n);
+  JointVector ddq(n);
   const JointVector tau_rate_max = robot.dtau_max * dt;
   const JointVector ddq_step_max = robot.dddq_max * dt;
 
@@ -184,30 +279,8 @@ RolloutResult simulate(const Simulator& sim, SimulatorWorkspace& ws, const Joint
       }
     }
 
-    // RK4 over one control period with the torque held.
     q_prev = q;
-    for (int sub = 0; sub < sim.options.substeps; ++sub) {
-      if (sim.options.integrator == Integrator::SemiImplicitEuler) {
-        k1v = sub == 0 ? forward_dynamics_from_terms(rd, tau)
-                       : forward_dynamics(robot, rd, q, dq, tau);
-        if (sub == 0) ddq = k1v;
-        dq += h * k1v;
-        q += h * dq;
-        continue;
-      }
-      k1q = dq;
-      k1v =
-          sub == 0 ? forward_dynamics_from_terms(rd, tau) : forward_dynamics(robot, rd, q, dq, tau);
-      if (sub == 0) ddq = k1v;
-      k2q = dq + 0.5 * h * k1v;
-      k2v = forward_dynamics(robot, rd, q + 0.5 * h * k1q, k2q, tau);
-      k3q = dq + 0.5 * h * k2v;
-      k3v = forward_dynamics(robot, rd, q + 0.5 * h * k2q, k3q, tau);
-      k4q = dq + h * k3v;
-      k4v = forward_dynamics(robot, rd, q + h * k3q, k4q, tau);
-      q += (h / 6) * (k1q + 2 * k2q + 2 * k3q + k4q);
-      dq += (h / 6) * (k1v + 2 * k2v + 2 * k3v + k4v);
-    }
+    integrate_period(sim, rd, tau, h, q, dq, ddq, k);
     if (!within(ddq, robot.ddq_max)) return finish(RolloutStatus::AccelerationLimit, tick);
     if (!within(ddq - ddq_prev, ddq_step_max)) return finish(RolloutStatus::JerkLimit, tick);
     ddq_prev = ddq;
@@ -217,26 +290,8 @@ RolloutResult simulate(const Simulator& sim, SimulatorWorkspace& ws, const Joint
     if (!within(dq, robot.dq_max)) return finish(RolloutStatus::VelocityLimit, tick + 1);
 
     result.path_length += (q - q_prev).norm();
-    // Collision checks spaced so that no point moves more than the margin between two.
-    const double step = sim.lever_arm.dot((q - q_prev).cwiseAbs());
-    if (moved + step > margin) {
-      if (moved > 0) {
-        const RolloutStatus c = collision_status(sim, ws, q_prev, result.collision_checks);
-        if (c != RolloutStatus::Valid) return finish(c, tick);
-      }
-      moved = step;
-      if (step > margin) {  // one tick moved too far: check in between as well
-        const int pieces = static_cast<int>(std::ceil(step / margin));
-        for (int j = 1; j < pieces; ++j) {
-          k1q = q_prev + (static_cast<double>(j) / pieces) * (q - q_prev);
-          const RolloutStatus c = collision_status(sim, ws, k1q, result.collision_checks);
-          if (c != RolloutStatus::Valid) return finish(c, tick);
-        }
-        moved = step / pieces;
-      }
-    } else {
-      moved += step;
-    }
+    const RolloutStatus c = check_motion(sim, ws, q_prev, q, moved, k.k1q, result.collision_checks);
+    if (c != RolloutStatus::Valid) return finish(c, tick);
     if (sample_every > 0 && (tick + 1) % sample_every == 0) {
       push_sample(samples, q, dq);
     }

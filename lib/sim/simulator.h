@@ -10,6 +10,7 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "lazyboe/collision/collision_model.h"
@@ -37,6 +38,11 @@ const char* rollout_status_name(RolloutStatus status);
 // symplectic (velocity first, then position with the new velocity), 1 evaluation per step.
 enum class Integrator : uint8_t { RK4, SemiImplicitEuler };
 
+// "rk4" or "euler", as on the command line and in bundle headers.
+const char* integrator_name(Integrator integrator);
+// The inverse; throws Error("<where>: expected euler or rk4, got '<name>'").
+Integrator parse_integrator(const std::string& name, const std::string& where);
+
 struct SimulationOptions {
   Integrator integrator = Integrator::RK4;
   int substeps = 1;               // integration steps per control period
@@ -44,6 +50,15 @@ struct SimulationOptions {
   double max_settle_time = 1.0;   // after the command ends, s
   int sample_every = 20;          // control ticks between stored trajectory samples (0: none)
 };
+
+// Stored-sample spacing: control ticks <-> seconds. sample_every_ticks rounds to the nearest
+// tick, so an interval below half a control period gives 0 (no samples; callers that need
+// samples take std::max(1, ...)).
+int sample_every_ticks(double interval_s, double control_rate);
+double sample_interval_seconds(int ticks, double control_rate);
+// sample_every_ticks for an interval that must be a whole number of control periods (0 is);
+// throws Error("<where>: must be a multiple of the control period (<period> s)") otherwise.
+int exact_sample_every_ticks(double interval_s, double control_rate, const std::string& where);
 
 struct Simulator {
   Simulator(const RobotModel& robot, const CollisionModel& collision, SimulationOptions options);

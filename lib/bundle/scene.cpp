@@ -1,0 +1,31 @@
+#include "lazyboe/bundle/scene.h"
+
+#include "lazyboe/common/error.h"
+#include "lazyboe/common/hash.h"
+
+namespace lazyboe {
+
+std::string robot_identity(const RobotModel& robot) {
+  return hash_files({robot.config_path, robot.urdf_path});
+}
+
+std::string environment_identity(const Environment& env) { return hash_files({env.path}); }
+
+BundleScene load_bundle_scene(const BundleHeader& h, std::string robot_path, std::string env_path) {
+  if (robot_path.empty()) robot_path = h.robot_config;
+  if (env_path.empty()) env_path = h.env_file;
+  BundleScene scene{load_robot(robot_path), load_environment(env_path)};
+  const std::string robot_hash = robot_identity(scene.robot);
+  if (robot_hash != h.robot_hash) {
+    fail(robot_path, "is not the robot the bundle was built with (" + h.robot_config + ", hash " +
+                         h.robot_hash + "; this one hashes to " + robot_hash + ")");
+  }
+  const std::string env_hash = environment_identity(scene.env);
+  if (env_hash != h.env_hash) {
+    fail(env_path, "is not the environment the bundle was built with (" + h.env_file + ", hash " +
+                       h.env_hash + "; this one hashes to " + env_hash + ")");
+  }
+  return scene;
+}
+
+}  // namespace lazyboe
