@@ -109,7 +109,7 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--planners", planners,
                  "all, or a comma-separated list of lazyboe, boe, rrt, sst (= sst-0.5x, sst-1x, "
-                 "sst-2x), ompl-rrt, ompl-sst, ompl-kpiece")
+                 "sst-2x), lazysp, ompl-rrt, ompl-sst, ompl-kpiece")
       ->capture_default_str();
   app.add_option("--repeats", repeats, "Runs per planner and problem, with different seeds")
       ->capture_default_str()
