@@ -460,6 +460,26 @@ PlanningContext session_context(const Fixture& f, const Simulator& sim) {
   return out;
 }
 
+// The end-state index finds exactly the edges a scan of every end state finds.
+TEST(LazySp, TheEndStateIndexAgreesWithAScan) {
+  const Fixture& f = fixture();
+  EXPECT_EQ(end_index().point(), EdgePoint::End);
+  EXPECT_EQ(f.index.point(), EdgePoint::Start);
+  std::vector<std::pair<uint32_t, double>> found;
+  for (const JointVector& q : {f.a, f.b, f.c}) {
+    for (const double radius : {0.1, 0.3, 0.75}) {
+      end_index().within(q.data(), radius, found);
+      std::vector<uint32_t> ids, scanned;
+      for (const auto& [e, d2] : found) ids.push_back(e);
+      for (size_t e = 0; e < f.view.size(); ++e) {
+        const JointVector end = Eigen::Map<const Eigen::VectorXd>(f.view.qf(e), f.robot.dof);
+        if ((end - q).norm() < radius) scanned.push_back(static_cast<uint32_t>(e));
+      }
+      EXPECT_EQ(ids, scanned) << "radius " << radius;
+    }
+  }
+}
+
 // A lazysp result passes realize_path on `sim`, the independent re-validation, and its
 // commands re-simulated one after another from the start land exactly on the trajectory's
 // end: no predicted state is in it. Returns the trajectory.
@@ -479,6 +499,7 @@ Trajectory expect_revalidated(const Fixture& f, const Simulator& sim, const Plan
   return t;
 }
 
+// At its first solution (deterministic) and after improving it for the whole budget (anytime).
 TEST(LazySp, ReturnsFullyRevalidatedPathsOfSimulatedEdges) {
   const Fixture& f = fixture();
   const PlanningContext context = session_context(f, f.sim);
@@ -486,19 +507,25 @@ TEST(LazySp, ReturnsFullyRevalidatedPathsOfSimulatedEdges) {
   const std::vector<std::pair<JointVector, JointVector>> problems = {
       {f.a, f.b}, {f.a, f.c}, {f.c, f.a}};
   for (size_t k = 0; k < problems.size(); ++k) {
-    SCOPED_TRACE("problem " + std::to_string(k));
-    const PlanningProblem p = library_problem(problems[k].first, problems[k].second, 0.3);
-    const PlanResult r = plan(context, ws, "lazysp", {}, p);  // anytime: the whole budget
-    ASSERT_TRUE(r.success) << r.failure;
-    EXPECT_EQ(r.found_by, "bundle");
-    EXPECT_GT(r.counters.lazy_edges, 0u);  // predicted states, never simulated
-    EXPECT_GE(r.counters.simulations, r.best_path.size());
-    for (const PathStep& s : r.best_path) EXPECT_GE(s.bundle_edge, 0);
-    const Trajectory t = expect_revalidated(f, f.sim, p, r);
-    EXPECT_EQ(resimulate(f, p.start, bundle_commands(f, t.edges), t), "");
-    std::cout << "[ lazysp  ] problem " << k << ": " << r.best_path.size() << " edges, "
-              << r.counters.simulations << " simulations, first solution after "
-              << r.time_to_first_solution * 1e3 << " ms, " << r.n_solutions << " solutions\n";
+    for (const bool first : {true, false}) {
+      SCOPED_TRACE("problem " + std::to_string(k) + (first ? ", first solution" : ", anytime"));
+      PlanningProblem p = library_problem(problems[k].first, problems[k].second, first ? 10 : 0.3);
+      p.termination.stop_at_first = first;
+      const PlanResult r = plan(context, ws, "lazysp", {}, p);
+      ASSERT_TRUE(r.success) << r.failure;
+      EXPECT_GT(r.counters.lazy_edges, 0u);  // predicted states, never simulated
+      EXPECT_GE(r.counters.simulations, r.best_path.size());
+      const Trajectory t = expect_revalidated(f, f.sim, p, r);
+      if (!first) continue;
+      // The bundle covers these problems: the lazy search finds the path, of bundle edges.
+      EXPECT_EQ(r.found_by, "bundle");
+      EXPECT_EQ(r.n_solutions, 1);
+      for (const PathStep& s : r.best_path) EXPECT_GE(s.bundle_edge, 0);
+      EXPECT_EQ(resimulate(f, p.start, bundle_commands(f, t.edges), t), "");
+      std::cout << "[ lazysp  ] problem " << k << ": " << r.best_path.size() << " edges, "
+                << r.counters.simulations << " simulations to the first solution ("
+                << r.time_to_first_solution * 1e3 << " ms)\n";
+    }
   }
 }
 
