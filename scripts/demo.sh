@@ -29,7 +29,7 @@ echo
 echo "== 3. Perturbation analysis: 8 perturbed re-simulations per edge"
 "$bin/lazyboe-perturb" --bundle "$out/bundle.h5" --perturbations 8
 echo
-echo "== 4. Planning: data/queries/table-demo.jsonl (6 problems x lazyboe, boe, rrt, sst; 1 s each)"
+echo "== 4. Planning: data/queries/table-demo.jsonl (6 problems x lazyboe, boe, rrt, sst, lazysp; 1 s each)"
 "$bin/lazyboe-query" --bundle "$out/bundle.h5" --queries data/queries/table-demo.jsonl \
   --out "$out/results.jsonl" --jobs 2 --trajectories csv --trajectory-dir "$out/trajectories"
 echo "   results: $out/results.jsonl, trajectories: $out/trajectories/"

@@ -1,17 +1,21 @@
-// Planning through the library only: the four planners (LazyBoE, BoE, RRT, SST) with plan() and
+// Planning through the library only: the planners (LazyBoE, BoE, RRT, SST, lazysp) with plan() and
 // realize_path on one small dense bundle built and perturbed in memory (no tool runs).
 // Covered: every planner solves an easy problem; every returned trajectory passes the
 // independent re-validation of planning_fixture (and that re-validation catches broken ones);
 // the output is made of simulated edges only, LazyBoE does take edges lazily while the others
 // never do; a RolloutPool changes nothing but who simulates; LazyBoE refuses a bundle without
 // perturbation analysis; a start or goal outside the bundle's coverage fails at once with a
-// reason; a lazy chain without progress ends. test_query_cli runs the same through lazyboe-query.
+// reason; a lazy chain without progress ends. lazysp: fully re-validated paths of simulated
+// edges only, the same result for a seed with or without a pool, a goal beyond the bundle's
+// coverage solved by its growth, a candidate edge that collides repaired around.
+// test_query_cli runs the same through lazyboe-query.
 //
 // Run time matters: the bundle (2000 edges, p = 4) is built once per process, budgets are
 // 0.5-3 s.
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <iostream>
 #include <memory>
 #include <string>
 #include <thread>
@@ -26,6 +30,7 @@
 #include "lazyboe/planning/problem.h"
 #include "lazyboe/planning/registry.h"
 #include "lazyboe/planning/rollout_scheduler.h"
+#include "lazyboe/robot/kinematics.h"
 #include "lazyboe/sim/rollout_pool.h"
 #include "lazyboe/sim/simulator.h"
 #include "planning_fixture.h"
@@ -426,6 +431,194 @@ TEST(Planners, ALazyChainWithoutProgressEnds) {
   EXPECT_LE(r.counters.lazy_edges, r.counters.simulations + 2)
       << "lazy edges " << r.counters.lazy_edges << ", simulations " << r.counters.simulations
       << ": a lazy chain went on without simulating";
+}
+
+// ------------------------------------------------------------------------------------------
+// lazysp: lazy search over predicted states, forward validation, growth
+// ------------------------------------------------------------------------------------------
+
+// The context a planning session makes: with the k-d tree over edge end states too.
+const EdgeStartIndex& end_index() {
+  static const EdgeStartIndex ends(fixture().view, EdgePoint::End);
+  return ends;
+}
+
+PlanningContext session_context(const Fixture& f, const Simulator& sim) {
+  PlanningContext c = library_context(f, f.view, f.index);
+  PlanningContext out{sim, c.bundle, c.index};
+  out.end_index = &end_index();
+  out.theta = c.theta;
+  out.sample_lower = c.sample_lower;
+  out.sample_upper = c.sample_upper;
+  out.command = c.command;
+  return out;
+}
+
+// The end-state index finds exactly the edges a scan of every end state finds.
+TEST(LazySp, TheEndStateIndexAgreesWithAScan) {
+  const Fixture& f = fixture();
+  EXPECT_EQ(end_index().point(), EdgePoint::End);
+  EXPECT_EQ(f.index.point(), EdgePoint::Start);
+  std::vector<std::pair<uint32_t, double>> found;
+  for (const JointVector& q : {f.a, f.b, f.c}) {
+    for (const double radius : {0.1, 0.3, 0.75}) {
+      end_index().within(q.data(), radius, found);
+      std::vector<uint32_t> ids, scanned;
+      for (const auto& [e, d2] : found) ids.push_back(e);
+      for (size_t e = 0; e < f.view.size(); ++e) {
+        const JointVector end = Eigen::Map<const Eigen::VectorXd>(f.view.qf(e), f.robot.dof);
+        if ((end - q).norm() < radius) scanned.push_back(static_cast<uint32_t>(e));
+      }
+      EXPECT_EQ(ids, scanned) << "radius " << radius;
+    }
+  }
+}
+
+// A lazysp result passes realize_path on `sim`, the independent re-validation, and its
+// commands re-simulated one after another from the start land exactly on the trajectory's
+// end: no predicted state is in it. Returns the trajectory.
+Trajectory expect_revalidated(const Fixture& f, const Simulator& sim, const PlanningProblem& p,
+                              const PlanResult& r) {
+  SimulatorWorkspace ws(sim);
+  const Trajectory t = realize_path(sim, ws, p.start, r.best_path, p.goal, kSampleEvery);
+  EXPECT_EQ(validate(f, t, p.start, p.goal.q, kTolerance, "lazysp"), "");
+  std::vector<CommandProfile> commands;
+  for (const PathStep& s : r.best_path) {
+    commands.push_back({s.knots.data(), static_cast<int>(s.knots.size() / f.robot.dof), f.robot.dof,
+                        s.command_duration});
+  }
+  EXPECT_EQ(resimulate(f, p.start, commands, t), "");
+  EXPECT_NEAR(r.best_cost, t.cost, 1e-9 * (1 + t.cost));
+  EXPECT_EQ(t.edges.size(), r.best_path.size());
+  return t;
+}
+
+// At its first solution (deterministic) and after improving it for the whole budget (anytime).
+TEST(LazySp, ReturnsFullyRevalidatedPathsOfSimulatedEdges) {
+  const Fixture& f = fixture();
+  const PlanningContext context = session_context(f, f.sim);
+  SimulatorWorkspace ws(f.sim);
+  const std::vector<std::pair<JointVector, JointVector>> problems = {
+      {f.a, f.b}, {f.a, f.c}, {f.c, f.a}};
+  for (size_t k = 0; k < problems.size(); ++k) {
+    for (const bool first : {true, false}) {
+      SCOPED_TRACE("problem " + std::to_string(k) + (first ? ", first solution" : ", anytime"));
+      PlanningProblem p = library_problem(problems[k].first, problems[k].second, first ? 10 : 0.3);
+      p.termination.stop_at_first = first;
+      const PlanResult r = plan(context, ws, "lazysp", {}, p);
+      ASSERT_TRUE(r.success) << r.failure;
+      EXPECT_GT(r.counters.lazy_edges, 0u);  // predicted states, never simulated
+      EXPECT_GE(r.counters.simulations, r.best_path.size());
+      const Trajectory t = expect_revalidated(f, f.sim, p, r);
+      if (!first) continue;
+      // The bundle covers these problems: the lazy search finds the path, of bundle edges.
+      EXPECT_EQ(r.found_by, "bundle");
+      EXPECT_EQ(r.n_solutions, 1);
+      for (const PathStep& s : r.best_path) EXPECT_GE(s.bundle_edge, 0);
+      EXPECT_EQ(resimulate(f, p.start, bundle_commands(f, t.edges), t), "");
+      std::cout << "[ lazysp  ] problem " << k << ": " << r.best_path.size() << " edges, "
+                << r.counters.simulations << " simulations to the first solution ("
+                << r.time_to_first_solution * 1e3 << " ms)\n";
+    }
+  }
+}
+
+TEST(LazySp, IdenticalResultsForAFixedSeedWithOrWithoutAPool) {
+  const Fixture& f = fixture();
+  const PlanningContext context = session_context(f, f.sim);
+  PlanningProblem p = library_problem(f.a, f.c, 10);
+  p.termination.stop_at_first = true;
+  p.seed = 3;
+  SimulatorWorkspace ws(f.sim);
+  const PlanResult first = plan(context, ws, "lazysp", {}, p);
+  const PlanResult again = plan(context, ws, "lazysp", {}, p);
+  RolloutPool pool(f.sim, 3);
+  const PlanResult pooled = plan(context, ws, "lazysp", {}, p, &pool);
+  ASSERT_TRUE(first.success) << first.failure;
+  for (const PlanResult* r : {&again, &pooled}) {
+    EXPECT_EQ(r->success, first.success);
+    EXPECT_EQ(r->best_cost, first.best_cost);
+    EXPECT_EQ(r->n_solutions, first.n_solutions);
+    EXPECT_EQ(r->found_by, first.found_by);
+    EXPECT_EQ(r->counters.nodes, first.counters.nodes);
+    EXPECT_EQ(r->counters.simulations, first.counters.simulations);
+    EXPECT_EQ(r->counters.lazy_edges, first.counters.lazy_edges);
+    EXPECT_EQ(r->counters.collision_checks, first.counters.collision_checks);
+    ASSERT_EQ(r->best_path.size(), first.best_path.size());
+    for (size_t s = 0; s < first.best_path.size(); ++s) {
+      EXPECT_EQ(r->best_path[s].bundle_edge, first.best_path[s].bundle_edge) << "step " << s;
+      EXPECT_EQ(r->best_path[s].knots, first.best_path[s].knots) << "step " << s;
+    }
+  }
+}
+
+// A joint goal farther than theta + tolerance from every edge end: BoE fails at once (with the
+// end-state index as with the scan); lazysp reaches it through its growth.
+TEST(LazySp, AGoalBeyondTheBundlesCoverageIsSolvedByTheGrowth) {
+  const Fixture& f = fixture();
+  const double theta = f.view.perturbation_theta();
+  const JointVector goal =
+      far_state(f, f.b, {1.1, -1.1, 1.2, -1.2, 1.3, -1.3, 1.5, -1.5}, theta + kTolerance, true);
+  ASSERT_EQ(goal.size(), 7) << "no collision-free state just beyond the bundle's ends";
+  ASSERT_GT(nearest_distance(f, goal, true), theta + kTolerance);
+  const PlanningContext context = session_context(f, f.sim);
+  const PlanningContext scanning = library_context(f, f.view, f.index);  // no end index
+  SimulatorWorkspace ws(f.sim);
+  PlanningProblem p = library_problem(f.b, goal, 20);
+  p.termination.stop_at_first = true;
+  const PlanResult boe = plan(context, ws, "boe", {}, p);
+  EXPECT_FALSE(boe.success);
+  EXPECT_TRUE(contains(boe.failure, "goal")) << boe.failure;
+  EXPECT_EQ(plan(scanning, ws, "boe", {}, p).failure, boe.failure);
+
+  const PlanResult r = plan(context, ws, "lazysp", {}, p);
+  ASSERT_TRUE(r.success) << r.failure;
+  EXPECT_EQ(r.found_by, "growth");
+  EXPECT_EQ(r.best_path.back().bundle_edge, -1);  // the last step is a growth command
+  expect_revalidated(f, f.sim, p, r);
+  std::cout << "[ lazysp  ] beyond coverage: " << r.best_path.size() << " steps, "
+            << r.counters.simulations << " simulations, " << r.time_to_first_solution << " s\n";
+}
+
+// An obstacle the bundle never saw, on the way of lazysp's first path: the same first
+// candidate (the lazy search simulates nothing) now collides when simulated, and lazysp plans
+// around it instead of returning it.
+TEST(LazySp, ACandidateEdgeThatCollidesIsRepairedAround) {
+  const Fixture& f = fixture();
+  PlanningProblem p = library_problem(f.a, f.c, 10);
+  p.termination.stop_at_first = true;
+  SimulatorWorkspace ws(f.sim);
+  const PlanResult clear = plan(session_context(f, f.sim), ws, "lazysp", {}, p);
+  ASSERT_TRUE(clear.success) << clear.failure;
+  const Trajectory t = realize_path(f.sim, ws, p.start, clear.best_path, p.goal, kSampleEvery);
+  RobotData data(f.robot);
+  forward_kinematics(f.robot, data, t.q[t.q.size() / 2]);
+  Environment env = f.env;
+  Obstacle ball;
+  ball.name = "unseen";
+  ball.shape.type = ShapeType::Sphere;
+  ball.shape.radius = 0.04;
+  ball.pose.p = link_pose(f.robot, data, f.robot.tip_link()).p;
+  env.obstacles.push_back(ball);
+  const CollisionModel collision = build_collision_model(f.robot, env);
+  const Simulator blocked(f.robot, collision, f.sim.options);
+  SimulatorWorkspace bws(blocked);
+  ASSERT_EQ(check_state(blocked, bws, p.start), RolloutStatus::Valid);
+  ASSERT_EQ(check_state(blocked, bws, p.goal.q), RolloutStatus::Valid);
+  EXPECT_THROW(realize_path(blocked, bws, p.start, clear.best_path, p.goal, 0), Error);
+
+  const PlanResult r = plan(session_context(f, blocked), bws, "lazysp", {}, p);
+  ASSERT_TRUE(r.success) << r.failure;
+  EXPECT_EQ(r.found_by, "bundle");
+  EXPECT_GT(r.counters.simulations, r.best_path.size()) << "no simulation failed";
+  expect_revalidated(f, blocked, p, r);
+  std::vector<int64_t> before, after;
+  for (const PathStep& s : clear.best_path) before.push_back(s.bundle_edge);
+  for (const PathStep& s : r.best_path) after.push_back(s.bundle_edge);
+  EXPECT_NE(before, after);
+  std::cout << "[ lazysp  ] repaired: " << r.best_path.size() << " edges, "
+            << r.counters.simulations << " simulations (" << clear.counters.simulations
+            << " without the obstacle)\n";
 }
 
 }  // namespace

@@ -164,14 +164,17 @@ const ToolRun& tool_easy_run() {
 }
 
 // A batch that stops at the first solution (deterministic for a fixed seed; the budgets are
-// only a bound, far above the time the first solution takes): every planner a -> b, LazyBoE and
-// BoE b -> a, and last LazyBoE and BoE a -> c (paths of several steps, the slowest queries).
+// only a bound, far above the time the first solution takes): every planner a -> b, LazyBoE,
+// BoE and lazysp b -> a, lazysp a -> c, and last LazyBoE and BoE a -> c (paths of several steps,
+// the slowest queries).
 std::vector<json> deterministic_queries() {
   const Fixture& f = fixture();
   std::vector<json> q;
   for (const std::string& p : kPlanners) q.push_back(query(p + "-ab", f.a, f.b, p, 5, true, 3));
   q.push_back(query("lazyboe-ba", f.b, f.a, "lazyboe", 5, true, 5));
   q.push_back(query("boe-ba", f.b, f.a, "boe", 5, true, 5));
+  q.push_back(query("lazysp-ba", f.b, f.a, "lazysp", 5, true, 5));
+  q.push_back(query("lazysp-ac", f.a, f.c, "lazysp", 10, true, 7));
   q.push_back(query("lazyboe-ac", f.a, f.c, "lazyboe", 10, true, 7));
   q.push_back(query("boe-ac", f.a, f.c, "boe", 10, true, 7));
   return q;
@@ -639,21 +642,24 @@ TEST(QueryCli, IncompleteMissingAndUnperturbedBundlesAreRefused) {
   EXPECT_TRUE(contains(t2.r.err, missing)) << describe(t2.r);
 
   // No perturbation analysis: lazyboe gets an error result saying to run lazyboe-perturb;
-  // boe on the same bundle still works. (The library refuses it too: test_planners.)
+  // boe and lazysp on the same bundle still work. (The library refuses it too: test_planners.)
   const BundleView plain = BundleView::open(f.unperturbed);
   EXPECT_FALSE(plain.has_perturbation());
-  const std::string batch = write_temp_file("refused/unperturbed.jsonl",
-                                            jsonl({query("lazy", f.a, f.b, "lazyboe", 1, true),
-                                                   query("plain", f.a, f.b, "boe", 2, true)}));
+  const std::string batch = write_temp_file(
+      "refused/unperturbed.jsonl",
+      jsonl({query("lazy", f.a, f.b, "lazyboe", 1, true), query("plain", f.a, f.b, "boe", 2, true),
+             query("plain-sp", f.a, f.b, "lazysp", 2, true)}));
   const ToolRun t3 = query_tool({"--bundle", f.unperturbed, "--queries", batch, "--quiet"});
   ASSERT_EQ(t3.r.exit_code, 0) << describe(t3.r);
-  ASSERT_EQ(t3.results.size(), 2u) << describe(t3.r);
+  ASSERT_EQ(t3.results.size(), 3u) << describe(t3.r);
   EXPECT_EQ(t3.results[0].value("success", true), false);
   EXPECT_EQ(t3.results[0].value("line", -1), 1);
   EXPECT_TRUE(t3.results[0].contains("error") &&
               contains(t3.results[0]["error"].get<std::string>(), "lazyboe-perturb"))
       << t3.results[0].dump();
   expect_solved(t3.results[1], "boe without perturbation");
+  expect_solved(t3.results[2], "lazysp without perturbation");  // P_collision taken as 0
+  EXPECT_EQ(t3.results[2].value("found_by", ""), "bundle") << t3.results[2].dump();
 }
 
 // ------------------------------------------------------------------------------------------

@@ -74,7 +74,8 @@ TEST(Registry, SchemaDeclaresEveryParameterWithItsRange) {
 }
 
 TEST(Registry, NamesAndLookups) {
-  EXPECT_EQ(planner_names_text(), "lazyboe, boe, rrt, sst, ompl-rrt, ompl-sst or ompl-kpiece");
+  EXPECT_EQ(planner_names_text(),
+            "lazyboe, boe, rrt, sst, lazysp, ompl-rrt, ompl-sst or ompl-kpiece");
   EXPECT_EQ(find_planner("prm"), nullptr);
   const std::string e = message_of([] { planner_info("prm"); });
   EXPECT_EQ(e, "planner: unknown planner 'prm' (expected " + planner_names_text() + ")");
@@ -82,10 +83,13 @@ TEST(Registry, NamesAndLookups) {
   EXPECT_TRUE(find_planner("boe")->needs.bundle);
   EXPECT_FALSE(find_planner("boe")->needs.perturbation);
   EXPECT_FALSE(find_planner("rrt")->needs.bundle);
+  EXPECT_TRUE(find_planner("lazysp")->needs.bundle);
+  EXPECT_FALSE(find_planner("lazysp")->needs.perturbation);
   const std::vector<std::string> all = all_parameter_names();
   EXPECT_EQ(std::set<std::string>(all.begin(), all.end()),
-            (std::set<std::string>{"theta", "goal_bias", "selection_radius", "pruning_ratio"}));
-  EXPECT_EQ(all.size(), 4u);  // each once
+            (std::set<std::string>{"theta", "goal_bias", "selection_radius", "pruning_ratio",
+                                   "epsilon", "resolution", "risk_weight", "expansion_limit"}));
+  EXPECT_EQ(all.size(), 8u);  // each once
 }
 
 TEST(Registry, MakePlannerChecksValues) {

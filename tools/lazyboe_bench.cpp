@@ -15,6 +15,7 @@
 #include "lazyboe/common/atomic_file.h"
 #include "lazyboe/planning/ompl/ompl_planners.h"
 #include "lazyboe/planning/planning_session.h"
+#include "lazyboe/planning/registry.h"
 #include "tool_main.h"
 
 namespace {
@@ -105,8 +106,8 @@ void add_options(CLI::App& app, BenchOptions& o) {
   app.add_option("--seed", o.seed, "Study seed (problems and per-run planner seeds)")
       ->capture_default_str();
   app.add_option("--planners", o.planners,
-                 "all, or a comma-separated list of lazyboe, boe, rrt, sst (= sst-0.5x, sst-1x, "
-                 "sst-2x), ompl-rrt, ompl-sst, ompl-kpiece")
+                 "all, or a comma-separated list of " + planner_names_text() +
+                     " (sst = sst-0.5x, sst-1x, sst-2x; see lazyboe-query --list-planners)")
       ->capture_default_str();
   app.add_option("--repeats", o.repeats, "Runs per planner and problem, with different seeds")
       ->capture_default_str()

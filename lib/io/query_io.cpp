@@ -125,6 +125,7 @@ nlohmann::json result_json(const Query& q, const PlanResult& r, const Trajectory
                    {"lazy_edges", r.counters.lazy_edges},
                    {"collision_checks", r.counters.collision_checks}};
   if (!r.success) j["failure"] = r.failure;
+  if (r.success && !r.found_by.empty()) j["found_by"] = r.found_by;
   if (traj) {
     j["duration"] = traj->duration;
     j["edges"] = traj->edges;

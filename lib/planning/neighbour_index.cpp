@@ -7,11 +7,14 @@ namespace lazyboe {
 
 namespace {
 
-// nanoflann's view of the edge starts.
+// nanoflann's view of the edge starts (or ends).
 struct StartPoints {
   const BundleView* bundle;
+  EdgePoint point;
   size_t kdtree_get_point_count() const { return bundle->size(); }
-  double kdtree_get_pt(size_t idx, size_t dim) const { return bundle->q0(idx)[dim]; }
+  double kdtree_get_pt(size_t idx, size_t dim) const {
+    return (point == EdgePoint::Start ? bundle->q0(idx) : bundle->qf(idx))[dim];
+  }
   template <class BBox>
   bool kdtree_get_bbox(BBox&) const {
     return false;
@@ -26,14 +29,17 @@ using Tree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<do
 struct EdgeStartIndex::Impl {
   StartPoints points;
   Tree tree;
-  explicit Impl(const BundleView& b)
-      : points{&b}, tree(b.dof(), points, nanoflann::KDTreeSingleIndexAdaptorParams(16)) {
+  Impl(const BundleView& b, EdgePoint point)
+      : points{&b, point}, tree(b.dof(), points, nanoflann::KDTreeSingleIndexAdaptorParams(16)) {
     tree.buildIndex();
   }
 };
 
-EdgeStartIndex::EdgeStartIndex(const BundleView& bundle) : impl_(std::make_unique<Impl>(bundle)) {}
+EdgeStartIndex::EdgeStartIndex(const BundleView& bundle, EdgePoint point)
+    : impl_(std::make_unique<Impl>(bundle, point)) {}
 EdgeStartIndex::~EdgeStartIndex() = default;
+
+EdgePoint EdgeStartIndex::point() const { return impl_->points.point; }
 
 void EdgeStartIndex::within(const double* q, double radius,
                             std::vector<std::pair<uint32_t, double>>& out) const {

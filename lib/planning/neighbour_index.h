@@ -1,4 +1,5 @@
-// RADIAL_NN over the bundle's edge start states: a k-d tree (nanoflann) built at load.
+// RADIAL_NN over the bundle's edge start states (the planners' neighbourhoods) or end states
+// (goal coverage): a k-d tree (nanoflann) built at load.
 #pragma once
 
 #include <memory>
@@ -9,16 +10,21 @@
 
 namespace lazyboe {
 
+// Which state of every edge an index holds.
+enum class EdgePoint { Start, End };
+
 class EdgeStartIndex {
  public:
-  explicit EdgeStartIndex(const BundleView& bundle);
+  explicit EdgeStartIndex(const BundleView& bundle, EdgePoint point = EdgePoint::Start);
   ~EdgeStartIndex();
   EdgeStartIndex(const EdgeStartIndex&) = delete;
   EdgeStartIndex& operator=(const EdgeStartIndex&) = delete;
 
-  // Edges whose start lies within `radius` (Euclidean, joint space) of q, sorted by edge id so
-  // results do not depend on the tree's traversal order. `out` is reused (no allocation once
-  // it has grown).
+  EdgePoint point() const;
+
+  // Edges whose start (end, for an EdgePoint::End index) lies within `radius` (Euclidean, joint
+  // space) of q, sorted by edge id so results do not depend on the tree's traversal order. `out` is
+  // reused (no allocation once it has grown).
   void within(const double* q, double radius, std::vector<std::pair<uint32_t, double>>& out) const;
 
  private:

@@ -24,6 +24,7 @@ PlanningSession::PlanningSession(const std::string& bundle_path, bool memory_map
       settings(settings_from_header(bundle.header())),
       sim(scene.robot, collision, unsampled(settings.simulation)),
       index(bundle),
+      end_index(bundle, EdgePoint::End),
       load_seconds(std::chrono::duration<double>(Clock::now() - started_).count()) {}
 
 double PlanningSession::default_theta() const {
@@ -32,6 +33,7 @@ double PlanningSession::default_theta() const {
 
 PlanningContext PlanningSession::context() const {
   PlanningContext c{sim, &bundle, &index};
+  c.end_index = &end_index;
   c.theta = default_theta();
   c.sample_lower = settings.region_lower;
   c.sample_upper = settings.region_upper;

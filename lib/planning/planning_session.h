@@ -33,10 +33,11 @@ class PlanningSession {
   const BundleView bundle;
   const BundleScene scene;
   const CollisionModel collision;
-  const BuildSettings settings;  // the bundle's simulation, command and region settings
-  const Simulator sim;           // trajectories are not sampled (sample_every = 0)
-  const EdgeStartIndex index;
-  const double load_seconds;  // wall time of everything above
+  const BuildSettings settings;    // the bundle's simulation, command and region settings
+  const Simulator sim;             // trajectories are not sampled (sample_every = 0)
+  const EdgeStartIndex index;      // edge start states: the planners' neighbourhoods
+  const EdgeStartIndex end_index;  // edge end states: goal coverage
+  const double load_seconds;       // wall time of everything above
 
   // The planning context: the simulator, the bundle and its index, and from the bundle the
   // default theta (default_theta), the sampling box and the command family.

@@ -82,6 +82,9 @@ struct PlanResult {
   std::vector<PathStep> best_path;
   PlannerCounters counters;
   std::string failure;  // why there is no solution
+  // Which part of the planner found the best path, for planners with several ("bundle" or
+  // "growth" for lazysp); empty for the others.
+  std::string found_by;
 };
 
 struct Trajectory {

@@ -7,6 +7,7 @@
 #include "lazyboe/planning/ompl/ompl_planners.h"
 #include "lazyboe/planning/planners/boe.h"
 #include "lazyboe/planning/planners/lazyboe.h"
+#include "lazyboe/planning/planners/lazysp.h"
 #include "lazyboe/planning/planners/rrt.h"
 #include "lazyboe/planning/planners/sst.h"
 
@@ -15,8 +16,9 @@ namespace lazyboe {
 const std::vector<PlannerInfo>& planner_registry() {
   static const std::vector<PlannerInfo> registry = {
       lazyboe_planner_info(),  // the paper's planner first: the default
-      boe_planner_info(),      rrt_planner_info(),      sst_planner_info(),
-      ompl_rrt_planner_info(), ompl_sst_planner_info(), ompl_kpiece_planner_info(),
+      boe_planner_info(),         rrt_planner_info(),      sst_planner_info(),
+      lazysp_planner_info(),      ompl_rrt_planner_info(), ompl_sst_planner_info(),
+      ompl_kpiece_planner_info(),
   };
   return registry;
 }

@@ -50,7 +50,7 @@ const PlannerInfo* find_planner(const std::string& name);
 // The same, throwing Error("<where>: unknown planner 'x' (expected lazyboe, boe, ...)").
 const PlannerInfo& planner_info(const std::string& name, const std::string& where = "planner");
 
-// "lazyboe, boe, rrt, sst, ompl-rrt, ompl-sst or ompl-kpiece".
+// "lazyboe, boe, rrt, sst, lazysp, ompl-rrt, ompl-sst or ompl-kpiece".
 std::string planner_names_text();
 
 // Every parameter name any planner declares, each once.

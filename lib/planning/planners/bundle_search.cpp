@@ -32,6 +32,21 @@ double bundle_planner_setup(const PlanningContext& ctx, const ParameterValues& v
   return theta;
 }
 
+bool edge_ends_near(const PlanningContext& ctx, const JointVectorRef& q, double radius,
+                    std::vector<std::pair<uint32_t, double>>& scratch) {
+  if (ctx.end_index && ctx.end_index->point() == EdgePoint::End) {
+    ctx.end_index->within(q.data(), radius, scratch);
+    return !scratch.empty();
+  }
+  // Without the index: every end state, as before the index existed.
+  const BundleView& bundle = *ctx.bundle;
+  const int n = bundle.dof();
+  for (size_t e = 0; e < bundle.size(); ++e) {
+    if ((row(bundle.qf(e), n) - q).squaredNorm() <= radius * radius) return true;
+  }
+  return false;
+}
+
 BundleSearch::BundleSearch(const PlanningContext& ctx, SimulatorWorkspace& ws,
                            const PlanningProblem& p, double theta, RolloutPool* pool)
     : ctx_(ctx), bundle_(*ctx.bundle), s_(ctx, ws, p), theta_(theta), ahead_(pool) {}
@@ -76,10 +91,7 @@ bool BundleSearch::covered(Neighbours& neighbours) {
   const Goal& goal = s_.problem().goal;
   if (goal.kind != Goal::Kind::Joint) return true;
   const double reach = theta_ + goal.tolerance;
-  const int n = bundle_.dof();
-  for (size_t e = 0; e < bundle_.size(); ++e) {
-    if ((row(bundle_.qf(e), n) - goal.q).squaredNorm() <= reach * reach) return true;
-  }
+  if (edge_ends_near(ctx_, goal.q, reach, neighbours)) return true;
   s_.result().failure = "no bundle edge ends within theta + tolerance = " + std::to_string(reach) +
                         " rad of the goal: it is outside the bundle's coverage";
   return false;

@@ -95,6 +95,11 @@ ParameterSpec theta_parameter();
 double bundle_planner_setup(const PlanningContext& context, const ParameterValues& values,
                             const std::string& planner, bool perturbation);
 
+// Whether some bundle edge ends within `radius` of q: through the context's end-state index
+// when it has one (a k-d tree query), else by scanning every end state. `scratch` is reused.
+bool edge_ends_near(const PlanningContext& context, const JointVectorRef& q, double radius,
+                    std::vector<std::pair<uint32_t, double>>& scratch);
+
 // A bundle planner: Search (BundleSearch or a subclass) with theta from its parameters or the
 // context.
 template <class Search>

@@ -1,0 +1,399 @@
+#include "lazyboe/planning/planners/lazysp.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <queue>
+#include <unordered_map>
+#include <unordered_set>
+#include <utility>
+#include <vector>
+
+#include "lazyboe/planning/planners/bundle_search.h"
+#include "lazyboe/planning/planners/tree_search.h"
+#include "lazyboe/sim/random.h"
+
+namespace lazyboe {
+namespace {
+
+constexpr uint64_t kStream = 2;  // LazyBoE draws from stream 0, RRT and SST from 1
+// Scheduling between the lazy part and the growth is counted in work, not time, so that a
+// seed gives the same result on any machine: one rollout is worth about this many expansions
+// (a k-d tree query and its successors; measured on the 100k table bundle, ~1 ms vs ~20 us).
+constexpr double kExpansionsPerRollout = 50;
+constexpr double kHeadStart = 50;  // rollouts' worth of lazy work before growth gets a turn
+constexpr double kLazyShare = 3;   // then lazy work may be up to 3x the growth's
+
+struct Settings {
+  double theta = 0, epsilon = 2, resolution = 0.05, risk_weight = 0.5, goal_bias = 0.05;
+  size_t expansion_limit = 20000;
+};
+
+// A state of the lazy search: predicted (never simulated) or, for a source, a real node's.
+struct Predicted {
+  JointVector q;
+  double g = 0;       // real cost to the source plus the predicted edges' displacements and risk
+  int parent = -1;    // -1: a source
+  uint32_t edge = 0;  // from the parent
+  int real = -1;      // a source's real node
+  uint64_t cell = 0;
+};
+
+using Neighbours = std::vector<std::pair<uint32_t, double>>;
+
+class LazySpSearch {
+ public:
+  LazySpSearch(const PlanningContext& ctx, SimulatorWorkspace& ws, const PlanningProblem& p,
+               const Settings& settings)
+      : ctx_(ctx), bundle_(*ctx.bundle), s_(ctx, ws, p), set_(settings), rng_(p.seed, kStream) {}
+
+  PlanResult run();
+
+ private:
+  bool lazy_turn();
+  void lazy_round();
+  int search(size_t& expansions);
+  int expand(int p);
+  bool push(Predicted x, double h);
+  void validate(int goal);
+  void grow();
+  void sample(JointVector& x);
+  int nearest(const JointVector& x);
+  int add_real(const JointVector& q, int parent, int64_t edge, int command, double cost);
+  void found(int node, const char* by);
+  std::vector<PathStep> path_to(int node);
+  bool prunable(double g, double h);
+  bool within_limits(const JointVector& q) const;
+  uint64_t cell(const JointVector& q) const;
+  double risk(uint32_t e) const {
+    return bundle_.has_perturbation() ? set_.risk_weight * bundle_.p_collision(e) : 0.0;
+  }
+  static uint64_t key(int v, uint32_t e) { return (static_cast<uint64_t>(v) << 32) | e; }
+
+  const PlanningContext& ctx_;
+  const BundleView& bundle_;
+  SearchState s_;
+  const Settings set_;
+  Random rng_;
+  bool goal_covered_ = true;
+  std::unordered_set<uint64_t> tried_;  // (real node, edge) pairs simulated, valid or not
+  std::vector<PathStep> commands_;      // the growth's commands, by SearchNode::command
+  Neighbours neighbours_;
+  // One round of the lazy search (rebuilt every round from the real nodes).
+  std::vector<Predicted> preds_;
+  std::priority_queue<std::pair<double, int>, std::vector<std::pair<double, int>>, std::greater<>>
+      open_;
+  std::unordered_map<uint64_t, double> best_in_cell_;
+  // Scheduling, in rollouts' worth of work.
+  double lazy_work_ = 0, growth_work_ = 0;
+  bool exhausted_ = false;  // the last round found no candidate
+  size_t reals_at_exhaustion_ = 0;
+};
+
+PlanResult LazySpSearch::run() {
+  add_real(s_.problem().start, -1, -1, -1, 0);
+  // A predicted state x + qf(e) - q0(e), with x within theta of q0(e), lies within theta of
+  // qf(e): a joint goal farther than theta + tolerance from every edge end is beyond the lazy
+  // search, and only the growth can reach it.
+  const Goal& goal = s_.problem().goal;
+  if (goal.kind == Goal::Kind::Joint)
+    goal_covered_ = edge_ends_near(ctx_, goal.q, set_.theta + goal.tolerance, neighbours_);
+  while (!s_.should_stop()) {
+    if (lazy_turn()) {
+      lazy_round();
+    } else {
+      grow();
+    }
+  }
+  PlanResult& r = s_.result();
+  if (!r.success) r.failure = "no solution within the time budget";
+  return r;
+}
+
+// The lazy part runs first and while it has not used more than its share; after a round
+// without a candidate it waits for new real states and for the growth to have done as much.
+bool LazySpSearch::lazy_turn() {
+  if (!goal_covered_) return false;
+  if (exhausted_)
+    return s_.result().counters.nodes > reals_at_exhaustion_ && lazy_work_ <= growth_work_;
+  return lazy_work_ <= kHeadStart + kLazyShare * growth_work_;
+}
+
+void LazySpSearch::lazy_round() {
+  const uint64_t rollouts = s_.result().counters.simulations;
+  size_t expansions = 0;
+  const int goal = search(expansions);
+  if (goal >= 0) validate(goal);
+  lazy_work_ += static_cast<double>(expansions) / kExpansionsPerRollout +
+                static_cast<double>(s_.result().counters.simulations - rollouts);
+  exhausted_ = goal < 0;
+  reals_at_exhaustion_ = s_.result().counters.nodes;
+}
+
+// Weighted A* (f = g + epsilon h) from every real node at once, each with its real cost, over
+// predicted states; returns the predicted goal state of the candidate, or -1.
+int LazySpSearch::search(size_t& expansions) {
+  preds_.clear();
+  open_ = {};
+  best_in_cell_.clear();
+  const std::vector<SearchNode>& nodes = s_.nodes();
+  for (size_t v = 0; v < nodes.size(); ++v) {
+    const SearchNode& n = nodes[v];
+    if (s_.in_goal(n.h) || prunable(n.cost, n.h)) continue;  // a solution, or no better one
+    Predicted x;
+    x.q = n.q;
+    x.g = n.cost;
+    x.real = static_cast<int>(v);
+    push(x, n.h);
+  }
+  while (!open_.empty() && expansions < set_.expansion_limit) {
+    if (expansions % 64 == 0 && s_.deadline().passed()) return -1;
+    const int p = open_.top().second;
+    open_.pop();
+    if (best_in_cell_[preds_[p].cell] < preds_[p].g) continue;  // superseded in its cell
+    ++expansions;
+    const int goal = expand(p);
+    if (goal >= 0) return goal;
+  }
+  return -1;
+}
+
+// The successors of predicted state p by displacement transfer; the cheapest one in the goal
+// region, if any, is the candidate (goal test at generation: one expansion sooner).
+int LazySpSearch::expand(int p) {
+  const Predicted x = preds_[p];  // preds_ grows below
+  ctx_.index->within(x.q.data(), set_.theta, neighbours_);
+  const int n = bundle_.dof();
+  int goal = -1;
+  double goal_g = std::numeric_limits<double>::infinity();
+  for (const auto& [e, d2] : neighbours_) {
+    // From a real state, an edge simulated before is known: its real end is a source itself.
+    if (x.real >= 0 && tried_.count(key(x.real, e))) continue;
+    const JointVector step = Eigen::Map<const Eigen::VectorXd>(bundle_.qf(e), n) -
+                             Eigen::Map<const Eigen::VectorXd>(bundle_.q0(e), n);
+    Predicted c;
+    c.q = x.q + step;
+    if (!within_limits(c.q)) continue;
+    c.g = x.g + step.norm() + risk(e);  // |qf - q0| is a lower bound of the arc length
+    c.parent = p;
+    c.edge = e;
+    const double h = s_.heuristic(c.q);
+    if (prunable(c.g, h) || !push(c, h)) continue;
+    ++s_.result().counters.lazy_edges;
+    if (s_.in_goal(h) && c.g < goal_g) {
+      goal = static_cast<int>(preds_.size()) - 1;
+      goal_g = c.g;
+    }
+  }
+  return goal;
+}
+
+// Merging: a state is kept only if it is the cheapest so far in its cell of side `resolution`.
+bool LazySpSearch::push(Predicted x, double h) {
+  x.cell = cell(x.q);
+  const auto [it, fresh] = best_in_cell_.try_emplace(x.cell, x.g);
+  if (!fresh) {
+    if (it->second <= x.g) return false;
+    it->second = x.g;
+  }
+  open_.emplace(x.g + set_.epsilon * h, static_cast<int>(preds_.size()));
+  preds_.push_back(std::move(x));
+  return true;
+}
+
+// Simulates the candidate from its real source, edge by edge, each from the previous real end.
+// A failed edge stays tried from that real state; the valid prefix stays in the tree as real
+// nodes, from which the next round plans. A real end farther than theta/2 from its prediction
+// ends the validation: the rest of the candidate was planned from a place the robot is not.
+void LazySpSearch::validate(int goal) {
+  std::vector<int> chain;
+  int u = goal;
+  for (; preds_[u].parent >= 0; u = preds_[u].parent) chain.push_back(u);
+  std::reverse(chain.begin(), chain.end());
+  int r = preds_[u].real;
+  for (const int p : chain) {
+    if (s_.deadline().passed()) return;
+    const uint32_t e = preds_[p].edge;
+    tried_.insert(key(r, e));
+    const RolloutResult res = s_.simulate_from(s_.node(r).q, bundle_.command(e));
+    if (!res.valid()) return;
+    const int c = add_real(res.qf, r, e, -1, s_.node(r).cost + res.path_length);
+    if (s_.in_goal(s_.node(c).h)) {  // really in the goal region: a solution
+      found(c, "bundle");
+      return;
+    }
+    if ((res.qf - preds_[p].q).norm() > set_.theta / 2) return;
+    r = c;
+  }
+}
+
+// One RRT step from the real nodes: a goal-biased sample, its nearest real node, a random
+// command of the bundle's family.
+void LazySpSearch::grow() {
+  const int n = ctx_.sim.robot.dof;
+  JointVector x(n);
+  sample(x);
+  const int from = nearest(x);
+  std::vector<double> knots;
+  const double duration = sample_command_profile(ctx_.sim.robot, ctx_.command, rng_, knots);
+  const CommandProfile profile{knots.data(), static_cast<int>(knots.size() / n), n, duration};
+  const RolloutResult res = s_.simulate_from(s_.node(from).q, profile);
+  growth_work_ += 1;
+  if (!res.valid()) return;
+  commands_.push_back({-1, std::move(knots), duration});
+  const int c = add_real(res.qf, from, -1, static_cast<int>(commands_.size()) - 1,
+                         s_.node(from).cost + res.path_length);
+  if (s_.in_goal(s_.node(c).h)) found(c, "growth");
+}
+
+void LazySpSearch::sample(JointVector& x) {
+  const PlanningProblem& p = s_.problem();
+  if (p.goal.kind == Goal::Kind::Joint && rng_.uniform() < set_.goal_bias) {
+    x = p.goal.q;
+    return;
+  }
+  for (int i = 0; i < x.size(); ++i)
+    x[i] = rng_.uniform(ctx_.sample_lower[i], ctx_.sample_upper[i]);
+}
+
+int LazySpSearch::nearest(const JointVector& x) {
+  int best = 0;
+  double best_d = std::numeric_limits<double>::infinity();
+  const std::vector<SearchNode>& nodes = s_.nodes();
+  for (size_t v = 0; v < nodes.size(); ++v) {
+    const double d = (nodes[v].q - x).squaredNorm();
+    if (d < best_d) {
+      best_d = d;
+      best = static_cast<int>(v);
+    }
+  }
+  return best;
+}
+
+int LazySpSearch::add_real(const JointVector& q, int parent, int64_t edge, int command,
+                           double cost) {
+  SearchNode n;
+  n.q = q;
+  n.parent = parent;
+  n.bundle_edge = edge;
+  n.command = command;
+  n.cost = cost;
+  n.h = s_.heuristic(q);
+  return s_.add(std::move(n));
+}
+
+void LazySpSearch::found(int node, const char* by) {
+  const bool better = !(s_.node(node).cost >= s_.result().best_cost);
+  s_.solution(node, [this](int v) { return path_to(v); });
+  if (better) s_.result().found_by = by;
+}
+
+std::vector<PathStep> LazySpSearch::path_to(int node) {
+  std::vector<PathStep> steps;
+  for (int u = node; s_.node(u).parent >= 0; u = s_.node(u).parent) {
+    const SearchNode& n = s_.node(u);
+    if (n.bundle_edge < 0) {
+      steps.push_back(commands_[n.command]);
+      continue;
+    }
+    const CommandProfile c = bundle_.command(n.bundle_edge);
+    steps.push_back(
+        {n.bundle_edge, std::vector<double>(c.knots, c.knots + c.n_knots * c.dof), c.duration});
+  }
+  std::reverse(steps.begin(), steps.end());
+  return steps;
+}
+
+// After a solution, for joint goals: no state whose cost plus the least remaining arc length
+// cannot beat the best (as BoE).
+bool LazySpSearch::prunable(double g, double h) {
+  const PlanResult& r = s_.result();
+  if (!r.success || s_.problem().goal.kind != Goal::Kind::Joint) return false;
+  return g + std::max(0.0, h - s_.problem().goal.tolerance) >= r.best_cost;
+}
+
+bool LazySpSearch::within_limits(const JointVector& q) const {
+  const RobotModel& robot = ctx_.sim.robot;
+  return (q.array() >= robot.q_min.array()).all() && (q.array() <= robot.q_max.array()).all();
+}
+
+// A 64-bit hash of the cell's integer coordinates (two cells sharing a hash would merge: about
+// one chance in 10^10 per round of a million states).
+uint64_t LazySpSearch::cell(const JointVector& q) const {
+  uint64_t h = 0x9E3779B97F4A7C15ULL;
+  for (int i = 0; i < q.size(); ++i) {
+    const auto c = static_cast<int64_t>(std::floor(q[i] / set_.resolution));
+    h ^= static_cast<uint64_t>(c) + 0x9E3779B97F4A7C15ULL + (h << 6) + (h >> 2);
+    h *= 0xBF58476D1CE4E5B9ULL;
+    h ^= h >> 31;
+  }
+  return h;
+}
+
+class LazySpPlanner : public Planner {
+ public:
+  explicit LazySpPlanner(const ParameterValues& values) : values_(values) {}
+
+  void setup(const PlanningContext& context) override {
+    settings_.theta = bundle_planner_setup(context, values_, "lazysp", false);
+    check_sampling_box(context, "lazysp");
+    settings_.epsilon = values_.get("epsilon");
+    settings_.resolution = values_.get("resolution");
+    settings_.risk_weight = values_.get("risk_weight");
+    settings_.goal_bias = values_.get("goal_bias");
+    settings_.expansion_limit = static_cast<size_t>(values_.get("expansion_limit"));
+    context_ = &context;
+  }
+
+  PlanResult solve(const PlanningProblem& problem, SimulatorWorkspace& ws, RolloutPool*) override {
+    if (!context_) fail("lazysp", "solve before setup");
+    return LazySpSearch(*context_, ws, problem, settings_).run();
+  }
+
+ private:
+  ParameterValues values_;
+  Settings settings_;
+  const PlanningContext* context_ = nullptr;
+};
+
+ParameterSpec real_parameter(const char* name, double value, double lower, bool exclusive,
+                             const char* description) {
+  ParameterSpec p;
+  p.name = name;
+  p.default_value = value;
+  p.lower = lower;
+  p.lower_exclusive = exclusive;
+  p.description = description;
+  return p;
+}
+
+}  // namespace
+
+PlannerInfo lazysp_planner_info() {
+  PlannerInfo info;
+  info.name = "lazysp";
+  info.description =
+      "lazy shortest path over predicted (transferred) edge ends; simulates only the candidate "
+      "path; grows with random commands where the bundle does not reach; anytime";
+  info.needs.bundle = true;
+  ParameterSpec limit = real_parameter(
+      "expansion_limit", 20000, 1, false,
+      "predicted states expanded per round of the lazy search before it gives the growth a turn");
+  limit.type = ParameterType::Integer;
+  info.parameters = {
+      theta_parameter(),
+      real_parameter("epsilon", 2.0, 1, false,
+                     "heuristic weight of the lazy search (f = g + epsilon h; 1: A*)"),
+      real_parameter("resolution", 0.05, 0, true,
+                     "cell side, rad, below which predicted states are merged"),
+      real_parameter(
+          "risk_weight", 0.5, 0, false,
+          "rad of cost added per unit of an edge's P_collision (0 without perturbation)"),
+      goal_bias_parameter(),
+      limit,
+  };
+  info.make = [](const ParameterValues& v) { return std::make_unique<LazySpPlanner>(v); };
+  return info;
+}
+
+}  // namespace lazyboe
