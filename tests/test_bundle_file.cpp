@@ -566,12 +566,34 @@ Bundle viewable_bundle(size_t n, int dof, uint64_t seed) {
   return b;
 }
 
+// Adds the transfer statistics to a bundle's perturbation analysis (viewable_bundle has none,
+// like an analysis written before them).
+void add_transfer(Bundle& b, uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(0.0, 0.01);
+  Perturbation& p = b.perturbation;
+  p.has_transfer = true;
+  for (size_t k = 0; k < b.size(); ++k) {
+    const uint64_t lazy = p.valid[k] - p.valid[k] / 3;
+    p.transfer_lazy.push_back(lazy);
+    p.transfer_max_error.push_back(p.valid[k] ? u(rng) : std::nan(""));
+    p.p_lazy_prop_transfer.push_back(p.valid[k] ? static_cast<double>(lazy) / p.valid[k] : 0.0);
+  }
+}
+
+Bundle viewable_bundle_with_transfer(size_t n, int dof, uint64_t seed) {
+  Bundle b = viewable_bundle(n, dof, seed);
+  add_transfer(b, seed + 2);
+  return b;
+}
+
 // The first edge (and what) on which two views differ; "" when they agree bit for bit.
 std::string view_difference(const BundleView& a, const BundleView& b) {
   if (a.size() != b.size()) return "size";
   if (a.dof() != b.dof()) return "dof";
   if (a.has_perturbation() != b.has_perturbation()) return "has_perturbation";
   if (!same_bits(a.perturbation_theta(), b.perturbation_theta())) return "perturbation_theta";
+  if (a.has_transfer() != b.has_transfer()) return "has_transfer";
   const size_t n = static_cast<size_t>(a.dof());
   for (size_t e = 0; e < a.size(); ++e) {
     const std::string at = " of edge " + std::to_string(e);
@@ -586,6 +608,12 @@ std::string view_difference(const BundleView& a, const BundleView& b) {
     if (a.has_perturbation()) {
       if (!same_bits(a.p_lazy_prop(e), b.p_lazy_prop(e))) return "p_lazy_prop" + at;
       if (!same_bits(a.p_collision(e), b.p_collision(e))) return "p_collision" + at;
+    }
+    if (a.has_transfer()) {
+      if (!same_bits(a.p_lazy_prop_transfer(e), b.p_lazy_prop_transfer(e)))
+        return "p_lazy_prop_transfer" + at;
+      if (!same_bits(a.transfer_max_error(e), b.transfer_max_error(e)))
+        return "transfer_max_error" + at;
     }
   }
   return "";
@@ -660,6 +688,25 @@ TEST(BundleView, FromMemoryRefusesIncompleteAndInconsistentBundles) {
        {"bundle.perturbation.p_lazy_prop"}},
       {[](Bundle& b) { b.perturbation.p_collision.push_back(0); },
        {"bundle.perturbation.p_collision"}},
+      {[](Bundle& b) {
+         add_transfer(b, 1);
+         b.perturbation.transfer_lazy.pop_back();
+       },
+       {"bundle.perturbation.transfer_lazy", "9", "10"}},
+      {[](Bundle& b) {
+         add_transfer(b, 1);
+         b.perturbation.transfer_max_error.push_back(0);
+       },
+       {"bundle.perturbation.transfer_max_error", "11", "10"}},
+      {[](Bundle& b) {
+         add_transfer(b, 1);
+         b.perturbation.p_lazy_prop_transfer.clear();
+       },
+       {"bundle.perturbation.p_lazy_prop_transfer"}},
+      {[](Bundle& b) {
+         b.perturbation.has_transfer = true;  // flagged, with no arrays
+       },
+       {"bundle.perturbation.transfer_lazy"}},
       // Consistent for check_bundle, but an edge of one knot is no command.
       {[](Bundle& b) {
          b.knot_offset[1] = 1;
@@ -678,6 +725,123 @@ TEST(BundleView, FromMemoryRefusesIncompleteAndInconsistentBundles) {
       EXPECT_NE(message.find(part), std::string::npos) << message;
   }
   expect_error(error_of([&] { BundleView::from_memory(nullptr, name); }), name, {"no bundle"});
+}
+
+// ---- the transfer statistics: optional datasets of /perturbation ----------------------------
+
+// Bit-for-bit equality of two arrays (NaN equal to the same NaN).
+template <typename T>
+bool same_values(const char*, const std::vector<T>& a, const std::vector<T>& b) {
+  return a.size() == b.size() &&
+         (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
+}
+
+void expect_same_transfer(const Perturbation& a, const Perturbation& b) {
+  EXPECT_EQ(a.has_transfer, b.has_transfer);
+  EXPECT_TRUE(same_values("transfer_lazy", a.transfer_lazy, b.transfer_lazy));
+  EXPECT_TRUE(same_values("transfer_max_error", a.transfer_max_error, b.transfer_max_error));
+  EXPECT_TRUE(same_values("p_lazy_prop_transfer", a.p_lazy_prop_transfer, b.p_lazy_prop_transfer));
+  EXPECT_TRUE(same_values("p_lazy_prop", a.p_lazy_prop, b.p_lazy_prop));
+  EXPECT_TRUE(same_values("max_error", a.max_error, b.max_error));
+}
+
+TEST(BundleFile, TransferStatisticsRoundTripBitIdentical) {
+  const Bundle b = viewable_bundle_with_transfer(30, 7, 14);
+  const std::string path = fresh_path("transfer");
+  write_bundle(path, b);
+  const Bundle r = read_bundle(path);
+  ASSERT_TRUE(r.perturbation.has_transfer);
+  expect_same_transfer(b.perturbation, r.perturbation);
+  {
+    h5::File file = h5::open_file(path);
+    for (const char* name : {bundle_dataset::transfer_lazy, bundle_dataset::transfer_max_error,
+                             bundle_dataset::p_lazy_prop_transfer}) {
+      EXPECT_EQ(h5::dataset_shape(path, file, name), std::vector<uint64_t>{30}) << name;
+      const DatasetLocation loc = dataset_location(path, file, name);
+      EXPECT_TRUE(loc.contiguous) << name;
+      EXPECT_EQ(loc.bytes, 30 * 8u) << name;
+    }
+  }
+  const BundleView mapped = BundleView::open(path, true), read = BundleView::open(path, false);
+  const BundleView memory = BundleView::from_memory(std::make_shared<const Bundle>(b), "memory");
+  EXPECT_TRUE(mapped.memory_mapped());
+  ASSERT_TRUE(mapped.has_transfer());
+  ASSERT_TRUE(memory.has_transfer());
+  EXPECT_EQ(view_difference(mapped, memory), "");
+  EXPECT_EQ(view_difference(read, memory), "");
+  EXPECT_EQ(mapped.p_lazy_prop_transfer(3), b.perturbation.p_lazy_prop_transfer[3]);
+}
+
+// A bundle written before the transfer statistics (its /perturbation without them) opens
+// everywhere, without them.
+TEST(BundleFile, AnalysisWithoutTransferStatisticsStillOpens) {
+  const Bundle b = viewable_bundle(20, 7, 15);
+  ASSERT_FALSE(b.perturbation.has_transfer);
+  const std::string path = fresh_path("no-transfer");
+  write_bundle(path, b);
+  {
+    h5::File file = h5::open_file(path);
+    EXPECT_TRUE(h5::exists(file, bundle_dataset::p_lazy_prop));
+    EXPECT_FALSE(h5::exists(file, bundle_dataset::transfer_lazy));
+    EXPECT_FALSE(h5::exists(file, bundle_dataset::transfer_max_error));
+    EXPECT_FALSE(h5::exists(file, bundle_dataset::p_lazy_prop_transfer));
+  }
+  const Bundle r = read_bundle(path);
+  EXPECT_TRUE(r.perturbation.present);
+  EXPECT_FALSE(r.perturbation.has_transfer);
+  EXPECT_TRUE(r.perturbation.transfer_lazy.empty());
+  expect_same_transfer(b.perturbation, r.perturbation);
+  const BundleView view = BundleView::open(path);
+  EXPECT_TRUE(view.has_perturbation());
+  EXPECT_FALSE(view.has_transfer());
+  EXPECT_TRUE(view.warnings().empty());
+  const BundleView memory = BundleView::from_memory(std::make_shared<const Bundle>(b), "memory");
+  EXPECT_FALSE(memory.has_transfer());
+  EXPECT_EQ(view_difference(view, memory), "");
+}
+
+// The three come together: a file holding only some of them is refused, naming the missing one;
+// a wrong shape is refused as for every dataset.
+TEST(BundleFile, PartialOrMisshapenTransferStatisticsAreRefused) {
+  const std::string path = fresh_path("transfer-partial");
+  write_bundle(path, viewable_bundle_with_transfer(20, 7, 16));
+  {
+    h5::File file = h5::open_file_rw(path);
+    ASSERT_GE(H5Ldelete(file, bundle_dataset::transfer_max_error, H5P_DEFAULT), 0);
+    h5::close_file(path, file);
+  }
+  expect_error(error_of([&] { read_bundle(path); }), path,
+               {"/perturbation/transfer_max_error", "missing"});
+  const std::string shape = fresh_path("transfer-shape");
+  write_bundle(shape, viewable_bundle_with_transfer(20, 7, 16));
+  {
+    h5::File file = h5::open_file_rw(shape);
+    ASSERT_GE(H5Ldelete(file, bundle_dataset::transfer_lazy, H5P_DEFAULT), 0);
+    h5::write_dataset<uint64_t>("x", file, bundle_dataset::transfer_lazy, std::vector<uint64_t>(19),
+                                {19});
+    h5::close_file(shape, file);
+  }
+  expect_error(error_of([&] { read_bundle(shape); }), shape,
+               {"/perturbation/transfer_lazy", "19", "20"});
+}
+
+TEST(BundleFile, WriterRefusesWrongSizesOfTheTransferStatistics) {
+  const std::string path = fresh_path("transfer-sizes");
+  const Bundle good = viewable_bundle_with_transfer(10, 7, 17);
+  const std::vector<std::pair<std::function<void(Perturbation&)>, std::string>> cases = {
+      {[](Perturbation& p) { p.transfer_lazy.pop_back(); }, "bundle.perturbation.transfer_lazy"},
+      {[](Perturbation& p) { p.transfer_max_error.push_back(1); },
+       "bundle.perturbation.transfer_max_error"},
+      {[](Perturbation& p) { p.p_lazy_prop_transfer.clear(); },
+       "bundle.perturbation.p_lazy_prop_transfer"},
+  };
+  for (const auto& [spoil, field] : cases) {
+    Bundle b = good;
+    spoil(b.perturbation);
+    const std::string message = error_of([&] { write_bundle(path, b); });
+    expect_error(message, path, {field});
+    EXPECT_FALSE(fs::exists(path));
+  }
 }
 
 }  // namespace

@@ -41,6 +41,7 @@
 #include "cli_util.h"
 #include "lazyboe/bundle/bundle.h"
 #include "lazyboe/bundle/bundle_file.h"
+#include "lazyboe/bundle/bundle_view.h"
 #include "test_util.h"
 
 extern char** environ;
@@ -199,6 +200,12 @@ void expect_same_perturbation(const Perturbation& a, const Perturbation& b, bool
   EXPECT_TRUE(same_array("perturbation/max_error", a.max_error, b.max_error));
   EXPECT_TRUE(same_array("perturbation/p_lazy_prop", a.p_lazy_prop, b.p_lazy_prop));
   EXPECT_TRUE(same_array("perturbation/p_collision", a.p_collision, b.p_collision));
+  EXPECT_EQ(a.has_transfer, b.has_transfer);
+  EXPECT_TRUE(same_array("perturbation/transfer_lazy", a.transfer_lazy, b.transfer_lazy));
+  EXPECT_TRUE(
+      same_array("perturbation/transfer_max_error", a.transfer_max_error, b.transfer_max_error));
+  EXPECT_TRUE(same_array("perturbation/p_lazy_prop_transfer", a.p_lazy_prop_transfer,
+                         b.p_lazy_prop_transfer));
   EXPECT_NEAR(a.simulated_seconds, b.simulated_seconds,
               1e-9 * std::max(1.0, std::abs(b.simulated_seconds)));
   if (work) {
@@ -220,8 +227,14 @@ size_t check_invariants(const Bundle& b) {
   EXPECT_EQ(p.max_error.size(), N);
   EXPECT_EQ(p.p_lazy_prop.size(), N);
   EXPECT_EQ(p.p_collision.size(), N);
+  EXPECT_TRUE(p.has_transfer);
+  EXPECT_EQ(p.transfer_lazy.size(), N);
+  EXPECT_EQ(p.transfer_max_error.size(), N);
+  EXPECT_EQ(p.p_lazy_prop_transfer.size(), N);
   if (p.done.size() != N || p.valid.size() != N || p.lazy.size() != N || p.collision.size() != N ||
-      p.max_error.size() != N || p.p_lazy_prop.size() != N || p.p_collision.size() != N) {
+      p.max_error.size() != N || p.p_lazy_prop.size() != N || p.p_collision.size() != N ||
+      p.transfer_lazy.size() != N || p.transfer_max_error.size() != N ||
+      p.p_lazy_prop_transfer.size() != N) {
     return 0;
   }
   size_t finished = 0;
@@ -250,6 +263,17 @@ size_t check_invariants(const Bundle& b) {
       if (!std::isnan(p.max_error[e])) problems += " max_error is not NaN with no valid rollout;";
     } else if (!(p.max_error[e] >= 0)) {
       problems += " max_error is not >= 0 (or is NaN) with valid rollouts;";
+    }
+    if (p.transfer_lazy[e] > p.valid[e]) problems += " transfer_lazy > valid;";
+    const double transfer_prop =
+        p.valid[e] ? static_cast<double>(p.transfer_lazy[e]) / p.valid[e] : 0.0;
+    if (!same_double(p.p_lazy_prop_transfer[e], transfer_prop))
+      problems += " p_lazy_prop_transfer != transfer_lazy / valid;";
+    if (p.valid[e] == 0) {
+      if (!std::isnan(p.transfer_max_error[e]))
+        problems += " transfer_max_error is not NaN with no valid rollout;";
+    } else if (!(p.transfer_max_error[e] >= 0)) {
+      problems += " transfer_max_error is not >= 0 (or is NaN) with valid rollouts;";
     }
     if (!problems.empty()) {
       ADD_FAILURE() << where.str() << ":" << problems;
@@ -422,6 +446,9 @@ TEST(PerturbCli, BasicRunWritesConsistentProbabilities) {
         {"/perturbation/max_error", H5T_IEEE_F64LE},
         {"/perturbation/p_lazy_prop", H5T_IEEE_F64LE},
         {"/perturbation/p_collision", H5T_IEEE_F64LE},
+        {"/perturbation/transfer_lazy", H5T_STD_U64LE},
+        {"/perturbation/transfer_max_error", H5T_IEEE_F64LE},
+        {"/perturbation/p_lazy_prop_transfer", H5T_IEEE_F64LE},
     };
     for (const auto& e : expected) {
       SCOPED_TRACE(e.name);
@@ -437,6 +464,8 @@ TEST(PerturbCli, BasicRunWritesConsistentProbabilities) {
   EXPECT_TRUE(contains(r.out, "P_lazy_prop")) << r.out;
   EXPECT_TRUE(contains(r.out, "P_collision")) << r.out;
   EXPECT_TRUE(contains(r.out, "usable for lazy propagation")) << r.out;
+  EXPECT_TRUE(contains(r.out, "P_lazy_prop under transfer")) << r.out;
+  EXPECT_TRUE(contains(r.out, "max transfer residual")) << r.out;
   std::istringstream lines(r.out);
   std::string line;
   int bins = 0, last_bins = 0;
@@ -577,6 +606,91 @@ TEST(PerturbCli, ExtendRerunRefuseAndReplace) {
     EXPECT_FALSE(same_array("max_error", b.perturbation.max_error, s3.max_error))
         << "seeds 3 and 4 gave the same errors";
   }
+  EXPECT_TRUE(tmp_files_in(dir).empty()) << join(tmp_files_in(dir));
+}
+
+// An analysis written before the transfer statistics (the same file without their three
+// datasets, as an older lazyboe-perturb wrote it) opens everywhere without them, and
+// lazyboe-perturb redoes it whole to the numbers of a straight run.
+TEST(PerturbCli, AnalysisWithoutTransferStatisticsOpensAndIsRecomputed) {
+  const std::string& input = input_bundle(kSmallEdges, kSmallSeed);
+  const Bundle original = read_bundle(input);
+  const std::string dir = fresh_dir("old-analysis");
+  const std::string path = dir + "/b.h5";
+  const std::vector<std::string> settings = {"--perturbations", "4", "--seed", "3"};
+  const Bundle& straight = reference(input, settings);
+  auto make_old = [&] {
+    Bundle old = straight;
+    old.perturbation.has_transfer = false;
+    old.perturbation.transfer_lazy.clear();
+    old.perturbation.transfer_max_error.clear();
+    old.perturbation.p_lazy_prop_transfer.clear();
+    write_bundle(path, old);
+  };
+  make_old();
+  {
+    const Bundle b = read_bundle(path);
+    ASSERT_TRUE(b.perturbation.present);
+    ASSERT_FALSE(b.perturbation.has_transfer);
+    const BundleView view = BundleView::open(path);
+    EXPECT_TRUE(view.has_perturbation());
+    EXPECT_FALSE(view.has_transfer());
+    EXPECT_TRUE(view.warnings().empty());
+  }
+  {
+    const CommandResult inspect = build_tool({"--inspect", path});
+    ASSERT_EQ(inspect.exit_code, 0) << describe(inspect);
+    EXPECT_TRUE(contains(inspect.out, "P_lazy_prop")) << inspect.out;
+    EXPECT_TRUE(contains(inspect.out, "transfer statistics: none")) << inspect.out;
+  }
+  {
+    // lazyboe's query on it: a start and goal of one edge.
+    const int n = original.dof();
+    auto vec = [&](const std::vector<double>& q) {
+      std::string s = "[";
+      for (int i = 0; i < n; ++i) s += (i ? "," : "") + std::to_string(q[i]);
+      return s + "]";
+    };
+    const std::vector<double> q0(original.q0.begin(), original.q0.begin() + n);
+    const std::vector<double> qf(original.qf.begin(), original.qf.begin() + n);
+    const std::string queries = dir + "/q.jsonl";
+    write_bytes(queries, "{\"id\":\"old\",\"start\":" + vec(q0) + ",\"goal\":{\"q\":" + vec(qf) +
+                             ",\"tolerance\":0.3},\"planner\":\"lazyboe\",\"budget\":1,"
+                             "\"seed\":1,\"stop_at_first\":true}\n");
+    const CommandResult q = run(
+        tool_command("lazyboe-query", {"--bundle", path, "--queries", queries, "--out", "-"}, 60));
+    EXPECT_EQ(q.exit_code, 0) << describe(q);
+    EXPECT_TRUE(contains(q.out, "\"old\"")) << describe(q);
+  }
+  // Continuing it with its own settings (complete: nothing to do for the old counts) and
+  // extending it both recompute it whole, saying so once.
+  for (const std::string& p : {"4", "8"}) {
+    SCOPED_TRACE("to p = " + p);
+    make_old();
+    const CommandResult r =
+        perturb_tool({"--bundle", path, "--perturbations", p, "--seed", "3", "--threads", "2"});
+    ASSERT_EQ(r.exit_code, 0) << describe(r);
+    EXPECT_TRUE(contains(r.err, "no transfer statistics")) << describe(r);
+    EXPECT_TRUE(contains(r.err, "recomputing")) << describe(r);
+    size_t notes = 0;  // once, beside the progress lines
+    for (size_t at = r.err.find("no transfer statistics"); at != std::string::npos;
+         at = r.err.find("no transfer statistics", at + 1))
+      ++notes;
+    EXPECT_EQ(notes, 1u) << r.err;
+    const Bundle b = read_bundle(path);
+    EXPECT_TRUE(b.perturbation.complete);
+    EXPECT_EQ(check_invariants(b), kSmallEdges);
+    expect_same_perturbation(b.perturbation,
+                             reference(input, {"--perturbations", p, "--seed", "3"}).perturbation);
+    expect_same_edges(b, original);
+  }
+  // Fewer perturbations than it holds, or other settings, are refused as for any analysis.
+  make_old();
+  const auto before = snapshot(dir);
+  const CommandResult fewer =
+      perturb_tool({"--bundle", path, "--perturbations", "2", "--seed", "3", "--threads", "2"});
+  expect_one_line_error(fewer, {"--replace", path});
+  EXPECT_TRUE(snapshot(dir) == before);
   EXPECT_TRUE(tmp_files_in(dir).empty()) << join(tmp_files_in(dir));
 }
 

@@ -98,6 +98,12 @@ TEST(Perturbation, AnalyticCaseErrorEqualsThePerturbation) {
   EXPECT_NEAR(p.p_lazy_prop[0], 0.5, 0.1);
   EXPECT_EQ(p.p_collision[0], 0.0);
   EXPECT_TRUE(p.complete);
+  // Every perturbed copy also holds still: it ends where it started, at qf + d, so the
+  // transfer prediction is exact up to round-off.
+  ASSERT_TRUE(p.has_transfer);
+  EXPECT_EQ(p.transfer_lazy[0], 400u);
+  EXPECT_LT(p.transfer_max_error[0], 1e-9);
+  EXPECT_EQ(p.p_lazy_prop_transfer[0], 1.0);
 }
 
 TEST(Perturbation, EdgeNextToAnObstacleCollidesFarEdgeDoesNot) {
@@ -161,9 +167,15 @@ TEST(Perturbation, SameResultForAnyThreadCountAndWhenExtended) {
     EXPECT_EQ(one.collision, other->collision);
     EXPECT_EQ(one.p_lazy_prop, other->p_lazy_prop);
     EXPECT_EQ(one.p_collision, other->p_collision);
+    EXPECT_TRUE(other->has_transfer);
+    EXPECT_EQ(one.transfer_lazy, other->transfer_lazy);
+    EXPECT_EQ(one.p_lazy_prop_transfer, other->p_lazy_prop_transfer);
     for (size_t e = 0; e < one.max_error.size(); ++e) {
       EXPECT_TRUE(one.max_error[e] == other->max_error[e] ||
                   (std::isnan(one.max_error[e]) && std::isnan(other->max_error[e])));
+      EXPECT_TRUE(
+          one.transfer_max_error[e] == other->transfer_max_error[e] ||
+          (std::isnan(one.transfer_max_error[e]) && std::isnan(other->transfer_max_error[e])));
     }
   }
   uint64_t valid = 0, done = 0;
@@ -175,6 +187,112 @@ TEST(Perturbation, SameResultForAnyThreadCountAndWhenExtended) {
     EXPECT_LE(one.p_lazy_prop[e], 1.0);
   }
   EXPECT_GT(valid, done / 2);
+}
+
+// The transfer statistics are those of the sampled rollouts themselves: fresh simulations from
+// q0 + d_j (a new workspace, the simulator called directly) end within the stored bound of
+// qf + d_j, and their counts and maximum give back the stored numbers exactly.
+TEST(Perturbation, TransferStatisticsAreThoseOfFreshRollouts) {
+  Scene scene("table");
+  Bundle b = small_bundle(scene, 24);
+  PerturbSettings s;
+  s.perturbations = 6;
+  prepare_perturbation(b, s, false, "test");
+  ASSERT_EQ(run_perturbation(scene.sim, b, s, quiet(2)), PerturbOutcome::Complete);
+  const Perturbation& p = b.perturbation;
+  ASSERT_TRUE(p.has_transfer);
+  SimulatorWorkspace ws(scene.sim);
+  const int n = b.dof();
+  double sum_stored = 0, sum_transfer = 0;
+  size_t with_valid = 0;
+  for (size_t e = 0; e < b.size(); ++e) {
+    SCOPED_TRACE("edge " + std::to_string(e));
+    const JointVector q0 = Eigen::Map<const Eigen::VectorXd>(&b.q0[e * n], n);
+    const JointVector qf = Eigen::Map<const Eigen::VectorXd>(&b.qf[e * n], n);
+    const CommandProfile command{&b.knots[b.knot_offset[e] * n],
+                                 static_cast<int>(b.knot_offset[e + 1] - b.knot_offset[e]), n,
+                                 b.command_duration[e]};
+    uint64_t valid = 0, lazy = 0;
+    double max = 0;
+    for (uint64_t j = 0; j < s.perturbations; ++j) {
+      const JointVector d = perturbation_offset(s, n, e, j);
+      const RolloutResult r = simulate(scene.sim, ws, q0 + d, command);
+      const PerturbationSample sample = perturb_sample(scene.sim, ws, b, e, s, j);
+      ASSERT_EQ(sample.status, r.status);
+      if (!r.valid()) continue;
+      const double residual = (r.qf - (qf + d)).norm();
+      EXPECT_EQ(sample.transfer_error, residual);
+      EXPECT_EQ(sample.error, (r.qf - qf).norm());
+      EXPECT_LE(residual, p.transfer_max_error[e]);
+      max = valid ? std::max(max, residual) : residual;
+      ++valid;
+      lazy += residual < s.theta / 2;
+    }
+    ASSERT_EQ(valid, p.valid[e]);
+    EXPECT_EQ(lazy, p.transfer_lazy[e]);
+    EXPECT_EQ(p.p_lazy_prop_transfer[e], valid ? static_cast<double>(lazy) / valid : 0.0);
+    if (valid) {
+      EXPECT_EQ(max, p.transfer_max_error[e]);
+      sum_stored += p.max_error[e];
+      sum_transfer += p.transfer_max_error[e];
+      ++with_valid;
+    } else {
+      EXPECT_TRUE(std::isnan(p.transfer_max_error[e]));
+    }
+  }
+  // The physics the statistics are for: the transfer predicts the end far better than the
+  // stored end does (the stored-end error is about |d| itself).
+  ASSERT_GT(with_valid, b.size() / 2);
+  EXPECT_LT(sum_transfer, 0.2 * sum_stored);
+}
+
+// An analysis written before the transfer statistics (none stored) is redone whole with its
+// own settings when continued or extended, to the numbers of a straight run; what is refused
+// for any analysis is still refused.
+TEST(Perturbation, AnalysisWithoutTransferIsRecomputed) {
+  Scene scene("table");
+  const Bundle base = small_bundle(scene, 16);
+  PerturbSettings s;
+  s.perturbations = 4;
+  Bundle straight = base;
+  EXPECT_FALSE(prepare_perturbation(straight, s, false, "test"));
+  run_perturbation(scene.sim, straight, s, quiet(2));
+  for (const uint64_t p : {4, 6}) {
+    SCOPED_TRACE("to p = " + std::to_string(p));
+    Bundle old = straight;
+    Perturbation& q = old.perturbation;
+    q.has_transfer = false;
+    q.transfer_lazy.clear();
+    q.transfer_max_error.clear();
+    q.p_lazy_prop_transfer.clear();
+    PerturbSettings fewer = s;
+    fewer.perturbations = 2;
+    EXPECT_THROW(prepare_perturbation(old, fewer, false, "x.h5"), Error);
+    EXPECT_FALSE(old.perturbation.has_transfer);
+    PerturbSettings more = s;
+    more.perturbations = p;
+    EXPECT_TRUE(prepare_perturbation(old, more, false, "x.h5"));
+    EXPECT_TRUE(q.has_transfer);
+    EXPECT_FALSE(q.complete);
+    EXPECT_EQ(q.done, std::vector<uint64_t>(old.size(), 0));
+    EXPECT_EQ(q.simulated_seconds, 0.0);
+    ASSERT_EQ(run_perturbation(scene.sim, old, more, quiet(2)), PerturbOutcome::Complete);
+    Bundle fresh = base;
+    prepare_perturbation(fresh, more, false, "test");
+    run_perturbation(scene.sim, fresh, more, quiet(1));
+    const Perturbation& f = fresh.perturbation;
+    EXPECT_EQ(q.done, f.done);
+    EXPECT_EQ(q.valid, f.valid);
+    EXPECT_EQ(q.lazy, f.lazy);
+    EXPECT_EQ(q.collision, f.collision);
+    EXPECT_EQ(q.transfer_lazy, f.transfer_lazy);
+    EXPECT_EQ(q.p_lazy_prop, f.p_lazy_prop);
+    EXPECT_EQ(q.p_lazy_prop_transfer, f.p_lazy_prop_transfer);
+    for (size_t e = 0; e < old.size(); ++e) {
+      EXPECT_TRUE(q.transfer_max_error[e] == f.transfer_max_error[e] ||
+                  (std::isnan(q.transfer_max_error[e]) && std::isnan(f.transfer_max_error[e])));
+    }
+  }
 }
 
 TEST(Perturbation, OtherSettingsNeedReplace) {

@@ -416,6 +416,9 @@ TEST(Planners, ALazyChainWithoutProgressEnds) {
   p.max_error = {0.0};
   p.p_lazy_prop = {1.0};  // always taken lazily
   p.p_collision = {0.0};
+  p.transfer_lazy = {p.perturbations};
+  p.transfer_max_error = {0.0};
+  p.p_lazy_prop_transfer = {1.0};
   const BundleView view =
       BundleView::from_memory(std::make_shared<const Bundle>(one), "one self-loop edge");
   const EdgeStartIndex index(view);

@@ -1,6 +1,6 @@
 // lazyboe-perturb: the perturbation analysis of an edge bundle. For every edge, p perturbations
 // of its start state are re-simulated with the edge's command; P_lazy_prop and P_collision (and
-// the counts behind them) are written into the same bundle file.
+// the counts behind them, and the transfer statistics) are written into the same bundle file.
 #include <cstdio>
 
 #include "lazyboe/bundle/builder.h"
@@ -57,7 +57,12 @@ int main(int argc, char** argv) {
     options.sample_every = 0;
     const Simulator sim(scene.robot, collision, options);
 
-    prepare_perturbation(bundle, s, replace, bundle_path);
+    if (prepare_perturbation(bundle, s, replace, bundle_path) && !control.quiet) {
+      std::fprintf(stderr,
+                   "lazyboe-perturb: %s: its analysis has no transfer statistics (written by an "
+                   "older lazyboe): recomputing it whole with the same settings\n",
+                   bundle_path.c_str());
+    }
     if (bundle.perturbation.complete) {
       if (!control.quiet) {
         std::fprintf(

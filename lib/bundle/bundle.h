@@ -60,6 +60,13 @@ struct Perturbation {
   std::vector<double> max_error;    // over the valid ones (NaN when none), rad
   std::vector<double> p_lazy_prop;  // lazy / valid (0 when no perturbation was valid)
   std::vector<double> p_collision;  // collision / done
+  // Displacement transfer: the edge's command from q0 + d is predicted to end at qf + d; the
+  // transfer residual of a valid perturbation is |q^_f - (qf + d)|. Absent (has_transfer false,
+  // the three arrays empty) in an analysis written before these statistics existed.
+  bool has_transfer = false;
+  std::vector<uint64_t> transfer_lazy;       // of the valid ones, transfer residual < theta/2
+  std::vector<double> transfer_max_error;    // over the valid ones (NaN when none), rad
+  std::vector<double> p_lazy_prop_transfer;  // transfer_lazy / valid (0 when none valid)
 };
 
 struct Bundle {

@@ -201,6 +201,11 @@ void write_perturbation(const std::string& tmp, hid_t file, const Perturbation& 
   h5::write_dataset(tmp, file, ds::pert_max_error, p.max_error, {n});
   h5::write_dataset(tmp, file, ds::p_lazy_prop, p.p_lazy_prop, {n});
   h5::write_dataset(tmp, file, ds::p_collision, p.p_collision, {n});
+  if (p.has_transfer) {
+    h5::write_dataset(tmp, file, ds::transfer_lazy, p.transfer_lazy, {n});
+    h5::write_dataset(tmp, file, ds::transfer_max_error, p.transfer_max_error, {n});
+    h5::write_dataset(tmp, file, ds::p_lazy_prop_transfer, p.p_lazy_prop_transfer, {n});
+  }
 }
 
 }  // namespace
@@ -237,6 +242,11 @@ void check_bundle(const Bundle& b, const std::string& where) {
     check_size(where, "perturbation.max_error", p.max_error.size(), n, e);
     check_size(where, "perturbation.p_lazy_prop", p.p_lazy_prop.size(), n, e);
     check_size(where, "perturbation.p_collision", p.p_collision.size(), n, e);
+    if (p.has_transfer) {
+      check_size(where, "perturbation.transfer_lazy", p.transfer_lazy.size(), n, e);
+      check_size(where, "perturbation.transfer_max_error", p.transfer_max_error.size(), n, e);
+      check_size(where, "perturbation.p_lazy_prop_transfer", p.p_lazy_prop_transfer.size(), n, e);
+    }
   }
   check_offsets(where, "bundle.knot_offset", b.knot_offset, b.knots.size() / dof, "bundle.knots");
   check_offsets(where, "bundle.sample_offset", b.sample_offset, b.sample_q.size() / dof,
@@ -319,6 +329,23 @@ Bundle read_bundle(const std::string& path) {
     p.max_error = h5::read_dataset<double>(path, file, ds::pert_max_error, {n});
     p.p_lazy_prop = h5::read_dataset<double>(path, file, ds::p_lazy_prop, {n});
     p.p_collision = h5::read_dataset<double>(path, file, ds::p_collision, {n});
+    // The transfer statistics: absent from analyses written before them (all three or none).
+    const bool lazy = h5::exists(file, ds::transfer_lazy);
+    const bool max = h5::exists(file, ds::transfer_max_error);
+    const bool prob = h5::exists(file, ds::p_lazy_prop_transfer);
+    if (lazy || max || prob) {
+      for (const auto& [there, name] :
+           {std::pair{lazy, ds::transfer_lazy}, std::pair{max, ds::transfer_max_error},
+            std::pair{prob, ds::p_lazy_prop_transfer}}) {
+        if (!there)
+          fail(path,
+               std::string(name) + ": dataset missing (the other transfer statistics are present)");
+      }
+      p.has_transfer = true;
+      p.transfer_lazy = h5::read_dataset<uint64_t>(path, file, ds::transfer_lazy, {n});
+      p.transfer_max_error = h5::read_dataset<double>(path, file, ds::transfer_max_error, {n});
+      p.p_lazy_prop_transfer = h5::read_dataset<double>(path, file, ds::p_lazy_prop_transfer, {n});
+    }
   }
   return b;
 }

@@ -35,6 +35,10 @@ constexpr const char* pert_collision = "/perturbation/collision";    // N u64
 constexpr const char* pert_max_error = "/perturbation/max_error";    // N f64
 constexpr const char* p_lazy_prop = "/perturbation/p_lazy_prop";     // N f64
 constexpr const char* p_collision = "/perturbation/p_collision";     // N f64
+// Optional within /perturbation (absent in analyses written before them): all three or none.
+constexpr const char* transfer_lazy = "/perturbation/transfer_lazy";                // N u64
+constexpr const char* transfer_max_error = "/perturbation/transfer_max_error";      // N f64
+constexpr const char* p_lazy_prop_transfer = "/perturbation/p_lazy_prop_transfer";  // N f64
 }  // namespace bundle_dataset
 
 // Checks the in-memory bundle is self-consistent: schema_version 1, dof >= 1, region bounds of

@@ -94,6 +94,12 @@ BundleView BundleView::open(const std::string& path, bool allow_mmap) {
       v.perturbation_theta_ = h5::read_attr_f64(path, g, "theta");
       v.p_lazy_prop_ = v.attach<double>(file, ds::p_lazy_prop, {n}, allow_mmap);
       v.p_collision_ = v.attach<double>(file, ds::p_collision, {n}, allow_mmap);
+      // Optional: absent from analyses written before the transfer statistics.
+      if (h5::exists(file, ds::p_lazy_prop_transfer) && h5::exists(file, ds::transfer_max_error)) {
+        v.p_lazy_prop_transfer_ = v.attach<double>(file, ds::p_lazy_prop_transfer, {n}, allow_mmap);
+        v.transfer_max_error_ = v.attach<double>(file, ds::transfer_max_error, {n}, allow_mmap);
+        v.has_transfer_ = true;
+      }
     }
   }
   return v;
@@ -121,6 +127,11 @@ BundleView BundleView::from_memory(std::shared_ptr<const Bundle> bundle, std::st
     v.perturbation_theta_ = p.theta;
     v.p_lazy_prop_ = p.p_lazy_prop.data();
     v.p_collision_ = p.p_collision.data();
+    if (p.has_transfer) {
+      v.p_lazy_prop_transfer_ = p.p_lazy_prop_transfer.data();
+      v.transfer_max_error_ = p.transfer_max_error.data();
+      v.has_transfer_ = true;
+    }
   }
   return v;
 }

@@ -45,6 +45,11 @@ class BundleView {
   double perturbation_theta() const { return perturbation_theta_; }
   double p_lazy_prop(size_t edge) const { return p_lazy_prop_[edge]; }
   double p_collision(size_t edge) const { return p_collision_[edge]; }
+  // The transfer statistics of the analysis (lazyboe-perturb since they exist): false for an
+  // analysis written before them, or without a (finished) analysis.
+  bool has_transfer() const { return has_transfer_; }
+  double p_lazy_prop_transfer(size_t edge) const { return p_lazy_prop_transfer_[edge]; }
+  double transfer_max_error(size_t edge) const { return transfer_max_error_[edge]; }
 
   bool memory_mapped() const { return all_mapped_; }  // every dataset mapped
   const std::vector<std::string>& warnings() const { return warnings_; }
@@ -76,6 +81,9 @@ class BundleView {
   const double* knots_ = nullptr;
   const double* p_lazy_prop_ = nullptr;
   const double* p_collision_ = nullptr;
+  const double* p_lazy_prop_transfer_ = nullptr;
+  const double* transfer_max_error_ = nullptr;
+  bool has_transfer_ = false;
   double perturbation_theta_ = 0;
   bool has_perturbation_ = false;
 };

@@ -82,6 +82,39 @@ void print_perturbation_summary(const Bundle& b, std::FILE* out) {
                "P_select = (1 - P_collision) P_lazy_prop: mean %.3f; %.1f%% of edges >= 0.5 "
                "(usable for lazy propagation), %.1f%% never taken lazily (0)\n",
                qs.mean, 100.0 * usable / N, 100.0 * never / N);
+  print_transfer_summary(b, out);
+}
+
+void print_transfer_summary(const Bundle& b, std::FILE* out) {
+  const Perturbation& p = b.perturbation;
+  if (!p.present) return;
+  if (!p.has_transfer) {
+    std::fprintf(out,
+                 "transfer statistics: none (an analysis written by an older lazyboe; "
+                 "lazyboe-perturb recomputes it with them)\n");
+    return;
+  }
+  const size_t N = b.size();
+  if (N == 0) return;
+  std::vector<double> stored, transfer;
+  for (size_t e = 0; e < N; ++e) {
+    if (!p.valid[e]) continue;
+    stored.push_back(p.max_error[e]);
+    transfer.push_back(p.transfer_max_error[e]);
+  }
+  const Quantiles ql = quantiles(p.p_lazy_prop), qt = quantiles(p.p_lazy_prop_transfer);
+  std::fprintf(out,
+               "transfer (the command from q0 + d ends near qf + d): P_lazy_prop under transfer "
+               "mean %.3f, median %.3f, vs P_lazy_prop (stored end qf) mean %.3f, median %.3f\n",
+               qt.mean, qt.median, ql.mean, ql.median);
+  if (!transfer.empty()) {
+    const Quantiles qe = quantiles(stored), qr = quantiles(transfer);
+    std::fprintf(out,
+                 "max transfer residual |q^f - (qf + d)| per edge (rad): median %.4f, 90th "
+                 "percentile %.4f, max %.4f; vs max stored-end error |q^f - qf|: median %.4f, "
+                 "90th percentile %.4f, max %.4f\n",
+                 qr.median, qr.p90, qr.max, qe.median, qe.p90, qe.max);
+  }
 }
 
 void print_build_summary(const BundleHeader& h, std::FILE* out) {

@@ -16,7 +16,13 @@ void print_build_summary(const BundleHeader& header, std::FILE* out);
 
 // The perturbation analysis of a bundle: settings, distributions of both probabilities
 // (text histograms) and the share of edges usable for lazy propagation.
+// Ends with print_transfer_summary.
 void print_perturbation_summary(const Bundle& bundle, std::FILE* out);
+
+// The transfer statistics beside P_lazy_prop: mean P_lazy_prop under transfer vs P_lazy_prop,
+// and the per-edge maximum transfer residual vs the stored-end error (or a line saying the
+// analysis predates them). Nothing without an analysis.
+void print_transfer_summary(const Bundle& bundle, std::FILE* out);
 
 // Edge starts within `theta` (Euclidean, joint space) of random points of the sampling region:
 // the design check that a bundle holds enough neighbours for the planner.

@@ -28,6 +28,8 @@ constexpr uint64_t kPerturbSalt = 0x7065727475726221ULL;  // "perturb!"
 void set_probabilities(Perturbation& p, size_t e) {
   p.p_lazy_prop[e] = p.valid[e] ? static_cast<double>(p.lazy[e]) / p.valid[e] : 0.0;
   p.p_collision[e] = p.done[e] ? static_cast<double>(p.collision[e]) / p.done[e] : 0.0;
+  p.p_lazy_prop_transfer[e] =
+      p.valid[e] ? static_cast<double>(p.transfer_lazy[e]) / p.valid[e] : 0.0;
 }
 
 }  // namespace
@@ -44,34 +46,70 @@ JointVector perturbation_offset(const PerturbSettings& s, int dof, uint64_t edge
   return d * (r / norm);
 }
 
+namespace {
+
+struct EdgeInputs {
+  JointVector q0, qf;
+  CommandProfile profile;
+};
+
+EdgeInputs edge_inputs(const Bundle& b, size_t e) {
+  const int n = b.dof();
+  return EdgeInputs{Eigen::Map<const Eigen::VectorXd>(&b.q0[e * n], n),
+                    Eigen::Map<const Eigen::VectorXd>(&b.qf[e * n], n),
+                    CommandProfile{&b.knots[b.knot_offset[e] * n],
+                                   static_cast<int>(b.knot_offset[e + 1] - b.knot_offset[e]), n,
+                                   b.command_duration[e]}};
+}
+
+// Perturbation j of an edge: the rollout from q0 + d and both residuals of its end.
+PerturbationSample sample(const Simulator& sim, SimulatorWorkspace& ws, const EdgeInputs& in,
+                          const PerturbSettings& s, int dof, size_t e, uint64_t j,
+                          double* simulated) {
+  PerturbationSample out;
+  out.offset = perturbation_offset(s, dof, e, j);
+  const JointVector start = in.q0 + out.offset;
+  const RolloutResult r = simulate(sim, ws, start, in.profile);
+  if (simulated) *simulated += r.duration;
+  out.status = r.status;
+  if (r.valid()) {
+    out.error = (r.qf - in.qf).norm();
+    out.transfer_error = (r.qf - (in.qf + out.offset)).norm();
+  }
+  return out;
+}
+
+}  // namespace
+
+PerturbationSample perturb_sample(const Simulator& sim, SimulatorWorkspace& ws, const Bundle& b,
+                                  size_t e, const PerturbSettings& s, uint64_t j) {
+  return sample(sim, ws, edge_inputs(b, e), s, b.dof(), e, j, nullptr);
+}
+
 void perturb_edge(const Simulator& sim, SimulatorWorkspace& ws, const Bundle& b, size_t e,
                   const PerturbSettings& s, EdgePerturbationCounts& c) {
-  const int n = b.dof();
-  const JointVector q0 = Eigen::Map<const Eigen::VectorXd>(&b.q0[e * n], n);
-  const JointVector qf = Eigen::Map<const Eigen::VectorXd>(&b.qf[e * n], n);
-  const CommandProfile profile{&b.knots[b.knot_offset[e] * n],
-                               static_cast<int>(b.knot_offset[e + 1] - b.knot_offset[e]), n,
-                               b.command_duration[e]};
+  const EdgeInputs in = edge_inputs(b, e);
   for (uint64_t j = c.done; j < s.perturbations; ++j) {
-    const JointVector start = q0 + perturbation_offset(s, n, e, j);
-    const RolloutResult r = simulate(sim, ws, start, profile);
+    const PerturbationSample r = sample(sim, ws, in, s, b.dof(), e, j, &c.simulated_seconds);
     ++c.done;
-    c.simulated_seconds += r.duration;
     if (r.status == RolloutStatus::SelfCollision || r.status == RolloutStatus::EnvCollision) {
       ++c.collision;
-    } else if (r.valid()) {
-      const double error = (r.qf - qf).norm();
-      c.max_error = c.valid ? std::max(c.max_error, error) : error;
+    } else if (r.status == RolloutStatus::Valid) {
+      c.max_error = c.valid ? std::max(c.max_error, r.error) : r.error;
+      c.transfer_max_error =
+          c.valid ? std::max(c.transfer_max_error, r.transfer_error) : r.transfer_error;
       ++c.valid;
-      if (error < s.theta / 2) ++c.lazy;
+      if (r.error < s.theta / 2) ++c.lazy;
+      if (r.transfer_error < s.theta / 2) ++c.transfer_lazy;
     }
   }
 }
 
-void prepare_perturbation(Bundle& b, const PerturbSettings& s, bool replace,
+bool prepare_perturbation(Bundle& b, const PerturbSettings& s, bool replace,
                           const std::string& path) {
   Perturbation& p = b.perturbation;
   const size_t n = b.size();
+  bool recompute = false;
   if (p.present && !replace) {
     if (p.theta != s.theta) {
       fail(path, "holds a perturbation analysis for theta " + exact(p.theta) +
@@ -85,10 +123,15 @@ void prepare_perturbation(Bundle& b, const PerturbSettings& s, bool replace,
       fail(path, "holds " + std::to_string(p.perturbations) +
                      " perturbations per edge already; use --replace to start over with fewer");
     }
-    p.perturbations = s.perturbations;
-    p.complete =
-        std::all_of(p.done.begin(), p.done.end(), [&](uint64_t d) { return d >= s.perturbations; });
-    return;
+    if (p.has_transfer) {
+      p.perturbations = s.perturbations;
+      p.complete = std::all_of(p.done.begin(), p.done.end(),
+                               [&](uint64_t d) { return d >= s.perturbations; });
+      return false;
+    }
+    // Written before the transfer statistics: the rollouts done so far would have to be
+    // simulated again for them anyway, so the analysis is redone whole with the same settings.
+    recompute = true;
   }
   p = Perturbation{};
   p.present = true;
@@ -102,13 +145,20 @@ void prepare_perturbation(Bundle& b, const PerturbSettings& s, bool replace,
   p.max_error.assign(n, std::numeric_limits<double>::quiet_NaN());
   p.p_lazy_prop.assign(n, 0.0);
   p.p_collision.assign(n, 0.0);
+  p.has_transfer = true;
+  p.transfer_lazy.assign(n, 0);
+  p.transfer_max_error.assign(n, std::numeric_limits<double>::quiet_NaN());
+  p.p_lazy_prop_transfer.assign(n, 0.0);
   p.complete = n == 0;
+  return recompute;
 }
 
 PerturbOutcome run_perturbation(const Simulator& sim, Bundle& b, const PerturbSettings& s,
                                 const PerturbControl& control) {
   Perturbation& p = b.perturbation;
   const size_t n = b.size();
+  if (!p.present || !p.has_transfer)
+    fail("run_perturbation", "the analysis is not prepared (call prepare_perturbation first)");
   const int threads = control.threads > 0 ? control.threads : omp_get_max_threads();
   std::vector<SimulatorWorkspace> workspaces;
   workspaces.reserve(threads);
@@ -149,6 +199,8 @@ PerturbOutcome run_perturbation(const Simulator& sim, Bundle& b, const PerturbSe
       c.lazy = p.lazy[e];
       c.collision = p.collision[e];
       c.max_error = p.valid[e] ? p.max_error[e] : 0.0;
+      c.transfer_lazy = p.transfer_lazy[e];
+      c.transfer_max_error = p.valid[e] ? p.transfer_max_error[e] : 0.0;
       c.simulated_seconds = 0;
       perturb_edge(sim, workspaces[omp_get_thread_num()], b, e, s, c);
     }
@@ -160,6 +212,9 @@ PerturbOutcome run_perturbation(const Simulator& sim, Bundle& b, const PerturbSe
       p.lazy[e] = c.lazy;
       p.collision[e] = c.collision;
       p.max_error[e] = c.valid ? c.max_error : std::numeric_limits<double>::quiet_NaN();
+      p.transfer_lazy[e] = c.transfer_lazy;
+      p.transfer_max_error[e] =
+          c.valid ? c.transfer_max_error : std::numeric_limits<double>::quiet_NaN();
       p.simulated_seconds += c.simulated_seconds;
       set_probabilities(p, e);
     }

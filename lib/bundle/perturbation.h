@@ -5,6 +5,9 @@
 //   P_lazy_prop = (valid rollouts ending within theta/2 of the stored end state) / (valid ones)
 //                 (0 when none is valid: such an edge is never taken lazily)
 //   P_collision = (rollouts failing the collision check) / p
+// and the displacement-transfer statistics of the same valid rollouts: the largest residual
+// |q^_f - (qf + d)| (the command from q0 + d predicted to end at qf + d) and the share of them
+// with residual below theta/2 (P_lazy_prop under transfer).
 // Perturbation j of edge i draws only from the stream (seed, i, j): any thread count gives the
 // same numbers, and raising p later adds perturbations p_old..p_new-1 to the same counts.
 #pragma once
@@ -37,8 +40,24 @@ JointVector perturbation_offset(const PerturbSettings& settings, int dof, uint64
 struct EdgePerturbationCounts {
   uint64_t done = 0, valid = 0, lazy = 0, collision = 0;
   double max_error = 0;  // valid > 0 only
+  // Displacement transfer: residual |q^_f - (qf + d)| of the valid rollouts.
+  uint64_t transfer_lazy = 0;     // residual < theta/2
+  double transfer_max_error = 0;  // valid > 0 only
   double simulated_seconds = 0;
 };
+
+// The residuals of one perturbation of an edge (what perturb_edge counts).
+struct PerturbationSample {
+  JointVector offset;         // d
+  RolloutStatus status{};     // of the rollout from q0 + d
+  double error = 0;           // |q^_f - qf| (valid rollouts only)
+  double transfer_error = 0;  // |q^_f - (qf + d)| (valid rollouts only)
+};
+
+// Simulates perturbation j of edge `edge` alone (the same rollout perturb_edge counts).
+PerturbationSample perturb_sample(const Simulator& sim, SimulatorWorkspace& ws,
+                                  const Bundle& bundle, size_t edge,
+                                  const PerturbSettings& settings, uint64_t j);
 
 // Runs perturbations [counts.done, settings.perturbations) of one edge, adding to `counts`.
 void perturb_edge(const Simulator& sim, SimulatorWorkspace& ws, const Bundle& bundle, size_t edge,
@@ -46,8 +65,11 @@ void perturb_edge(const Simulator& sim, SimulatorWorkspace& ws, const Bundle& bu
 
 // Sets up bundle.perturbation for `settings`: keeps the existing counts when theta and seed
 // match and p does not shrink (they are extended), starts afresh when `replace` is set, and
-// refuses otherwise with a message naming the difference.
-void prepare_perturbation(Bundle& bundle, const PerturbSettings& settings, bool replace,
+// refuses otherwise with a message naming the difference. An analysis without the transfer
+// statistics (written by an older lazyboe) that would otherwise be kept is recomputed from
+// scratch with the same settings (its counts cannot be extended consistently); the return
+// value says so (true: recomputing such an analysis).
+bool prepare_perturbation(Bundle& bundle, const PerturbSettings& settings, bool replace,
                           const std::string& path);
 
 enum class PerturbOutcome { Complete, Interrupted };
