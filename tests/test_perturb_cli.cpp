@@ -664,7 +664,7 @@ TEST(PerturbCli, AnalysisWithoutTransferStatisticsOpensAndIsRecomputed) {
   }
   // Continuing it with its own settings (complete: nothing to do for the old counts) and
   // extending it both recompute it whole, saying so once.
-  for (const std::string& p : {"4", "8"}) {
+  for (const std::string p : {"4", "8"}) {
     SCOPED_TRACE("to p = " + p);
     make_old();
     const CommandResult r =

@@ -56,6 +56,11 @@ TEST(Registry, SchemaDeclaresEveryParameterWithItsRange) {
       SCOPED_TRACE(info.name + "." + p.name);
       ASSERT_TRUE(props.contains(p.name));
       const nlohmann::json& s = props.at(p.name);
+      if (p.type == ParameterType::Choice) {
+        EXPECT_EQ(s.at("enum").get<std::vector<std::string>>(), p.choices);
+        EXPECT_FALSE(p.description.empty());
+        continue;
+      }
       const char* type = p.type == ParameterType::Boolean   ? "boolean"
                          : p.type == ParameterType::Integer ? "integer"
                                                             : "number";
@@ -87,9 +92,10 @@ TEST(Registry, NamesAndLookups) {
   EXPECT_FALSE(find_planner("lazysp")->needs.perturbation);
   const std::vector<std::string> all = all_parameter_names();
   EXPECT_EQ(std::set<std::string>(all.begin(), all.end()),
-            (std::set<std::string>{"theta", "goal_bias", "selection_radius", "pruning_ratio",
-                                   "epsilon", "resolution", "risk_weight", "expansion_limit"}));
-  EXPECT_EQ(all.size(), 8u);  // each once
+            (std::set<std::string>{"theta", "lazy_model", "goal_bias", "selection_radius",
+                                   "pruning_ratio", "epsilon", "resolution", "risk_weight",
+                                   "expansion_limit"}));
+  EXPECT_EQ(all.size(), 9u);  // each once
 }
 
 TEST(Registry, MakePlannerChecksValues) {
@@ -126,6 +132,14 @@ TEST(Registry, ParameterSpecTexts) {
   EXPECT_EQ(p.check(2), "must be true or false");
   p.default_value = 1;
   EXPECT_EQ(p.default_text(), "true");
+  p.type = ParameterType::Choice;
+  p.choices = {"stored", "transfer"};
+  EXPECT_EQ(p.range_text(), "stored or transfer");
+  EXPECT_EQ(p.default_text(), "transfer");
+  EXPECT_EQ(p.choice_index("stored"), 0);
+  EXPECT_EQ(p.choice_index("other"), -1);
+  EXPECT_EQ(p.check(1), "");
+  EXPECT_EQ(p.check(2), "must be stored or transfer");
 }
 
 TEST(Registry, TheListingNamesEveryPlannerAndParameter) {

@@ -22,6 +22,22 @@ const ParameterSpec& any_declaration(const std::string& name) {
   fail(name, "no planner declares this parameter");
 }
 
+double parameter_value(const JsonField& f, const ParameterSpec& spec) {
+  switch (spec.type) {
+    case ParameterType::Boolean:
+      return f.boolean() ? 1.0 : 0.0;
+    case ParameterType::Integer:
+      return static_cast<double>(f.integer());
+    case ParameterType::Choice: {
+      const int k = spec.choice_index(f.string());
+      if (k < 0) f.fail("expected " + spec.range_text());
+      return k;
+    }
+    default:
+      return f.number();
+  }
+}
+
 // The planner and the values of its declared parameters.
 void parse_planner(const JsonField& root, Query& q) {
   q.planner = root.has("planner") ? root.at("planner").string() : "lazyboe";
@@ -36,9 +52,7 @@ void parse_planner(const JsonField& root, Query& q) {
     // Another planner's parameter is checked by that planner's declaration, and ignored.
     const ParameterSpec* spec = info.parameter(name);
     const ParameterSpec& declared = spec ? *spec : any_declaration(name);
-    const double v = declared.type == ParameterType::Boolean   ? (f.boolean() ? 1.0 : 0.0)
-                     : declared.type == ParameterType::Integer ? static_cast<double>(f.integer())
-                                                               : f.number();
+    const double v = parameter_value(f, declared);
     const std::string why = declared.check(v);
     if (!why.empty()) f.fail(why);
     if (spec) q.parameters.set(name, v);

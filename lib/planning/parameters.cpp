@@ -15,8 +15,20 @@ std::string number_text(double v) {
 
 }  // namespace
 
+int ParameterSpec::choice_index(const std::string& key) const {
+  for (size_t k = 0; k < choices.size(); ++k)
+    if (choices[k] == key) return static_cast<int>(k);
+  return -1;
+}
+
 std::string ParameterSpec::range_text() const {
   if (type == ParameterType::Boolean) return "true or false";
+  if (type == ParameterType::Choice) {
+    std::string text;
+    for (size_t k = 0; k < choices.size(); ++k)
+      text += (k == 0 ? "" : k + 1 == choices.size() ? " or " : ", ") + choices[k];
+    return text;
+  }
   const bool has_lower = std::isfinite(lower), has_upper = std::isfinite(upper);
   if (has_lower && has_upper) {
     return std::string(lower_exclusive ? "(" : "[") + number_text(lower) + ", " +
@@ -30,6 +42,7 @@ std::string ParameterSpec::range_text() const {
 std::string ParameterSpec::default_text() const {
   if (!has_fixed_default()) return default_from;
   if (type == ParameterType::Boolean) return default_value != 0 ? "true" : "false";
+  if (type == ParameterType::Choice) return choices.at(static_cast<size_t>(default_value));
   return number_text(default_value);
 }
 
@@ -37,6 +50,10 @@ std::string ParameterSpec::check(double value) const {
   if (!std::isfinite(value)) return "must be a finite number";
   if (type == ParameterType::Boolean && value != 0 && value != 1) return "must be true or false";
   if (type == ParameterType::Integer && value != std::floor(value)) return "must be an integer";
+  if (type == ParameterType::Choice) {
+    const bool known = value >= 0 && value < choices.size() && value == std::floor(value);
+    return known ? "" : "must be " + range_text();
+  }
   const bool below = lower_exclusive ? !(value > lower) : !(value >= lower);
   if (below || value > upper) {
     const bool interval = std::isfinite(lower) && std::isfinite(upper);

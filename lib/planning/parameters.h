@@ -11,7 +11,8 @@
 
 namespace lazyboe {
 
-enum class ParameterType { Real, Integer, Boolean };
+// Choice: one of `choices`, carried as its index (in JSON, the name).
+enum class ParameterType { Real, Integer, Boolean, Choice };
 
 struct ParameterSpec {
   std::string name;
@@ -20,9 +21,13 @@ struct ParameterSpec {
   double default_value = std::numeric_limits<double>::quiet_NaN();
   double lower = -std::numeric_limits<double>::infinity();
   double upper = std::numeric_limits<double>::infinity();
-  bool lower_exclusive = false;  // (lower, upper] rather than [lower, upper]
-  std::string description;       // one line
-  std::string default_from;      // for a NaN default: where it comes from
+  bool lower_exclusive = false;      // (lower, upper] rather than [lower, upper]
+  std::string description;           // one line
+  std::string default_from;          // for a NaN default: where it comes from
+  std::vector<std::string> choices;  // Choice: the names, in index order
+
+  // Choice: the index of `name`, or -1.
+  int choice_index(const std::string& name) const;
 
   bool has_fixed_default() const { return !std::isnan(default_value); }
   // "> 0", "[0, 1]", "any": the allowed range, as the errors and --list-planners show it.

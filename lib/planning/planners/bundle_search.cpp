@@ -48,7 +48,8 @@ bool edge_ends_near(const PlanningContext& ctx, const JointVectorRef& q, double 
 }
 
 BundleSearch::BundleSearch(const PlanningContext& ctx, SimulatorWorkspace& ws,
-                           const PlanningProblem& p, double theta, RolloutPool* pool)
+                           const PlanningProblem& p, double theta, RolloutPool* pool,
+                           const ParameterValues&)
     : ctx_(ctx), bundle_(*ctx.bundle), s_(ctx, ws, p), theta_(theta), ahead_(pool) {}
 
 JointVector BundleSearch::edge_end(uint32_t e) const { return row(bundle_.qf(e), bundle_.dof()); }
@@ -117,7 +118,7 @@ void BundleSearch::expand(int v, Neighbours& neighbours) {
   s_.node(v).expanded = true;
   // Most promising edges first (heuristic at their stored end): the same edges are taken,
   // but a goal reached in this expansion is reached sooner.
-  order_by_promise(neighbours);
+  order_by_promise(v, neighbours);
   begin_expansion(v, neighbours);
   expanding_ = v;
   expansion_ = &neighbours;
@@ -128,8 +129,8 @@ void BundleSearch::expand(int v, Neighbours& neighbours) {
   }
 }
 
-void BundleSearch::order_by_promise(Neighbours& edges) {
-  for (auto& [e, key] : edges) key = heuristic_at_end(e);
+void BundleSearch::order_by_promise(int v, Neighbours& edges) {
+  for (auto& [e, key] : edges) key = promise(v, e);
   std::stable_sort(edges.begin(), edges.end(),
                    [](const auto& x, const auto& y) { return x.second < y.second; });
 }

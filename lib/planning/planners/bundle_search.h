@@ -21,7 +21,10 @@ namespace lazyboe {
 class BundleSearch {
  public:
   BundleSearch(const PlanningContext& ctx, SimulatorWorkspace& ws, const PlanningProblem& p,
-               double theta, RolloutPool* pool);
+               double theta, RolloutPool* pool, const ParameterValues& values = {});
+
+  // Checks, at setup, what the search needs beyond a bundle (none here).
+  static void check_context(const PlanningContext& /*ctx*/, const ParameterValues& /*values*/) {}
   virtual ~BundleSearch() = default;
 
   PlanResult run();
@@ -43,6 +46,9 @@ class BundleSearch {
     simulate_edge(v, e, k);
     return true;
   }
+  // The sort key of edge e in the expansion of v (smaller first): the heuristic at its stored
+  // end.
+  virtual double promise(int /*v*/, uint32_t e) { return heuristic_at_end(e); }
   // Whether neighbour k of the real node v needs a rollout from v in this expansion.
   virtual bool needs_rollout(int v, size_t k);
 
@@ -74,7 +80,7 @@ class BundleSearch {
   int pop();
   bool skip(int v);
   void expand(int v, Neighbours& neighbours);
-  void order_by_promise(Neighbours& edges);
+  void order_by_promise(int v, Neighbours& edges);
   bool prunable(int v);
   std::vector<PathStep> path_to(int node);
 
@@ -110,13 +116,14 @@ class BundlePlanner : public Planner {
 
   void setup(const PlanningContext& context) override {
     theta_ = bundle_planner_setup(context, values_, name_, perturbation_);
+    Search::check_context(context, values_);
     context_ = &context;
   }
 
   PlanResult solve(const PlanningProblem& problem, SimulatorWorkspace& ws,
                    RolloutPool* pool) override {
     if (!context_) fail(name_, "solve before setup");
-    return Search(*context_, ws, problem, theta_, pool).run();
+    return Search(*context_, ws, problem, theta_, pool, values_).run();
   }
 
  private:

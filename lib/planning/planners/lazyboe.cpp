@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "lazyboe/common/error.h"
 #include "lazyboe/planning/planners/bundle_search.h"
 #include "lazyboe/sim/random.h"
 
@@ -11,8 +12,18 @@ namespace {
 class LazySearch : public BundleSearch {
  public:
   LazySearch(const PlanningContext& ctx, SimulatorWorkspace& ws, const PlanningProblem& p,
-             double theta, RolloutPool* pool)
-      : BundleSearch(ctx, ws, p, theta, pool), rng_(p.seed, 0) {}
+             double theta, RolloutPool* pool, const ParameterValues& values)
+      : BundleSearch(ctx, ws, p, theta, pool),
+        transfer_(values.get("lazy_model") == kTransfer),
+        rng_(p.seed, 0) {}
+
+  static void check_context(const PlanningContext& ctx, const ParameterValues& values) {
+    if (values.get("lazy_model") == kTransfer && !ctx.bundle->has_transfer()) {
+      fail(ctx.bundle->path(),
+           "has no transfer statistics, which lazyboe's lazy_model transfer needs (run "
+           "lazyboe-perturb --replace with this version)");
+    }
+  }
 
  private:
   // Once the lazy search has run dry, every edge it took lazily is simulated from its node (a
@@ -48,7 +59,7 @@ class LazySearch : public BundleSearch {
     if (!lazy_search_) return;
     for (size_t k = 0; k < neighbours.size(); ++k) {
       const uint32_t e = neighbours[k].first;
-      take_lazy_[k] = rng_.uniform() < (1 - bundle_.p_collision(e)) * bundle_.p_lazy_prop(e);
+      take_lazy_[k] = rng_.uniform() < (1 - bundle_.p_collision(e)) * p_lazy_prop(e);
     }
   }
 
@@ -69,12 +80,26 @@ class LazySearch : public BundleSearch {
   // them at once).
   bool needs_rollout(int v, size_t k) override {
     if (!take_lazy_[k]) return BundleSearch::needs_rollout(v, k);
-    return s_.in_goal(heuristic_at_end(expansion_edge(k)));
+    return s_.in_goal(s_.heuristic(lazy_end(v, expansion_edge(k))));
+  }
+
+  double promise(int v, uint32_t e) override { return s_.heuristic(lazy_end(v, e)); }
+
+  // Where a lazy child of v by edge e is taken to be: the edge's stored end (the paper), or
+  // v's state moved by the edge's displacement (transfer: the command from a shifted start
+  // ends shifted by about as much).
+  JointVector lazy_end(int v, uint32_t e) {
+    return transfer_ ? JointVector(s_.node(v).q + (edge_end(e) - edge_start(e))) : edge_end(e);
+  }
+  double p_lazy_prop(uint32_t e) const {
+    return transfer_ ? bundle_.p_lazy_prop_transfer(e) : bundle_.p_lazy_prop(e);
   }
 
   void take_lazily(int v, uint32_t e, size_t k);
   bool realize(int x, long k = -1);
 
+  static constexpr double kTransfer = 1;  // lazy_model's index of "transfer"
+  const bool transfer_;
   Random rng_;
   bool exhaustive_ = false;
   bool lazy_search_ = false;
@@ -84,7 +109,7 @@ class LazySearch : public BundleSearch {
 void LazySearch::take_lazily(int v, uint32_t e, size_t k) {
   ++s_.result().counters.lazy_edges;
   SearchNode c;
-  c.q = edge_end(e);
+  c.q = lazy_end(v, e);
   c.parent = v;
   c.bundle_edge = e;
   c.lazy = true;
@@ -145,7 +170,15 @@ PlannerInfo lazyboe_planner_info() {
       "LazyBoE: BoE taking edges lazily with P_select = (1 - P_collision) P_lazy_prop";
   info.needs.bundle = true;
   info.needs.perturbation = true;
-  info.parameters = {theta_parameter()};
+  ParameterSpec model;
+  model.name = "lazy_model";
+  model.type = ParameterType::Choice;
+  model.choices = {"stored", "transfer"};
+  model.default_value = 0;
+  model.description =
+      "where a lazy edge ends: its stored end (the paper) or the node moved by the edge's "
+      "displacement, with P_lazy_prop under transfer";
+  info.parameters = {theta_parameter(), model};
   info.make = [](const ParameterValues& v) {
     return std::make_unique<BundlePlanner<LazySearch>>(v, "lazyboe", true);
   };
