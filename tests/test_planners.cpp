@@ -341,6 +341,60 @@ TEST(Planners, ARolloutPoolChangesNothingButWhoSimulates) {
 // ------------------------------------------------------------------------------------------
 
 // LazyBoE needs the analysis; boe on the same bundle works (test_query_cli).
+// lazy_model transfer: lazy children at the node moved by the edge's displacement, with
+// P_lazy_prop under transfer. It solves the easy problems with re-validated paths, takes edges
+// lazily, is repeatable and independent of a pool, and differs from the stored model.
+TEST(Planners, LazyBoEWithTransferSolvesWithValidPaths) {
+  const Fixture& f = fixture();
+  ASSERT_TRUE(f.view.has_transfer());
+  const PlanningContext context = library_context(f, f.view, f.index);
+  const ParameterValues transfer = {{"lazy_model", 1}};
+  uint64_t simulations[2] = {0, 0};
+  for (const JointVector* goal : {&f.b, &f.c}) {
+    PlanningProblem p = library_problem(f.a, *goal, 5);
+    p.termination.stop_at_first = true;
+    SimulatorWorkspace ws(f.sim);
+    const PlanResult r = plan(context, ws, "lazyboe", transfer, p);
+    ASSERT_TRUE(r.success) << r.failure;
+    EXPECT_GT(r.counters.lazy_edges, 0u);
+    const Trajectory t = realize_path(f.sim, ws, p.start, r.best_path, p.goal, kSampleEvery);
+    EXPECT_EQ(validate(f, t, f.a, *goal, kTolerance, "lazyboe"), "");
+    RolloutPool pool(f.sim, 3);
+    const PlanResult again = plan(context, ws, "lazyboe", transfer, p, &pool);
+    EXPECT_EQ(again.best_cost, r.best_cost);
+    EXPECT_EQ(again.counters.simulations, r.counters.simulations);
+    EXPECT_EQ(again.counters.lazy_edges, r.counters.lazy_edges);
+    const PlanResult stored = plan(context, ws, "lazyboe", {}, p);
+    ASSERT_TRUE(stored.success) << stored.failure;
+    simulations[0] += stored.counters.simulations;
+    simulations[1] += r.counters.simulations;
+  }
+  EXPECT_NE(simulations[0], simulations[1]) << "the two lazy models searched alike";
+}
+
+TEST(Planners, LazyBoEWithTransferRefusesABundleWithoutTransferStatistics) {
+  const Fixture& f = fixture();
+  Bundle old = f.data;
+  Perturbation& p = old.perturbation;
+  p.has_transfer = false;
+  p.transfer_lazy.clear();
+  p.transfer_max_error.clear();
+  p.p_lazy_prop_transfer.clear();
+  const BundleView view = BundleView::from_memory(std::make_shared<const Bundle>(old), "old");
+  ASSERT_TRUE(view.has_perturbation());
+  ASSERT_FALSE(view.has_transfer());
+  const EdgeStartIndex index(view);
+  const PlanningContext context = library_context(f, view, index);
+  SimulatorWorkspace ws(f.sim);
+  try {
+    plan(context, ws, "lazyboe", {{"lazy_model", 1}}, library_problem(f.a, f.b, 1));
+    ADD_FAILURE() << "lazy_model transfer ran without transfer statistics";
+  } catch (const Error& e) {
+    EXPECT_TRUE(contains(e.what(), "transfer statistics")) << e.what();
+  }
+  EXPECT_TRUE(plan(context, ws, "lazyboe", {}, library_problem(f.a, f.b, 1)).success);
+}
+
 TEST(Planners, LazyBoEOnABundleWithoutPerturbationIsRefused) {
   const Fixture& f = fixture();
   const BundleView plain = BundleView::from_memory(f.unperturbed, "the unperturbed bundle");

@@ -298,7 +298,9 @@ int run(const BenchOptions& o, const std::string& command_line) {
     std::fprintf(stderr, "lazyboe-bench: %s: %zu edges loaded in %.3f s\n", o.bundle_path.c_str(),
                  session.bundle.size(), session.load_seconds);
   }
-  const std::vector<PlannerSpec> specs = planner_specs(o.planners);
+  std::vector<PlannerSpec> specs = planner_specs(o.planners);
+  const PlanningContext context = session.context();
+  check_planner_specs(context, specs);
   for (const PlannerSpec& s : specs) {
     if (!s.available)
       std::fprintf(stderr, "lazyboe-bench: skipping %s: %s\n", s.name.c_str(),
@@ -335,7 +337,7 @@ int run(const BenchOptions& o, const std::string& command_line) {
     if (!o.quiet) print_run(r, problem_ids[r.problem], finished, total);
   };
   const std::vector<RunRecord> fresh =
-      run_study(session.context(), specs, problems, tasks, o.budget, o.seed, control);
+      run_study(context, specs, problems, tasks, o.budget, o.seed, control);
   runs.insert(runs.end(), fresh.begin(), fresh.end());
   if (fresh.size() < tasks.size()) {  // stopped before every run was done
     std::fprintf(stderr,

@@ -12,7 +12,7 @@ namespace lazyboe {
 
 namespace {
 
-// The names a study runs for a planner: its variants, or itself.
+// The names a study runs for a planner in "all": its variants, or itself.
 std::vector<std::string> study_names(const PlannerInfo& info) {
   if (info.study_variants.empty()) return {info.name};
   std::vector<std::string> names;
@@ -20,11 +20,25 @@ std::vector<std::string> study_names(const PlannerInfo& info) {
   return names;
 }
 
+bool has_variant(const PlannerInfo& info, const std::string& name) {
+  for (const PlannerVariant& v : info.study_variants)
+    if (v.name == name) return true;
+  return false;
+}
+
+// What a planner's name means in --planners: the variant of that name when it has one
+// (lazyboe), else every variant (sst), else the planner.
+std::vector<std::string> named_planners(const PlannerInfo& info) {
+  if (has_variant(info, info.name)) return {info.name};
+  return study_names(info);
+}
+
 std::string study_names_text() {
   std::vector<std::string> names = {"all"};
   for (const PlannerInfo& info : planner_registry()) {
     names.push_back(info.name);
-    for (const PlannerVariant& v : info.study_variants) names.push_back(v.name);
+    for (const PlannerVariant& v : info.study_variants)
+      if (v.name != info.name) names.push_back(v.name);
   }
   std::string text;
   for (size_t k = 0; k < names.size(); ++k)
@@ -59,7 +73,7 @@ std::vector<PlannerSpec> planner_specs(const std::string& list) {
       for (const PlannerInfo& i : planner_registry())
         for (const std::string& n : study_names(i)) names.push_back(n);
     } else if (info) {
-      for (const std::string& n : study_names(*info)) names.push_back(n);
+      for (const std::string& n : named_planners(*info)) names.push_back(n);
     } else {
       names.push_back(name);
     }
@@ -73,6 +87,18 @@ std::vector<PlannerSpec> planner_specs(const std::string& list) {
     specs.push_back(spec_named(name));
   }
   return specs;
+}
+
+void check_planner_specs(const PlanningContext& context, std::vector<PlannerSpec>& specs) {
+  for (PlannerSpec& s : specs) {
+    if (!s.available) continue;
+    try {
+      make_planner(s.planner, s.parameters)->setup(context);
+    } catch (const Error& e) {
+      s.available = false;
+      s.unavailable_reason = e.what();
+    }
+  }
 }
 
 uint64_t run_seed(uint64_t study_seed, int problem, int repeat) {

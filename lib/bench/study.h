@@ -22,10 +22,16 @@ struct PlannerSpec {
 
 // The study's planners, from the planner registry: "all" (every registered planner, or its
 // study variants where it has them: SST's sst-0.5x, sst-1x, sst-2x, the paper's pruning-to-
-// selection ratios) or a comma-separated list of names, where a planner with variants means
-// all of them ("sst"). Planners not built in (OMPL's without OMPL) are kept, marked
-// unavailable. Throws Error("--planners", ...) for an unknown name or one named twice.
+// selection ratios; lazyboe and lazyboe-transfer, its two lazy models) or a comma-separated
+// list of names, where a planner's name means its variant of that name if it has one
+// (lazyboe), else all its variants (sst). Planners not built in (OMPL's without OMPL) are
+// kept, marked unavailable. Throws Error("--planners", ...) for an unknown name or one named
+// twice.
 std::vector<PlannerSpec> planner_specs(const std::string& list);
+
+// Marks unavailable, with the reason, the planners that cannot run on this context (their
+// setup refuses it: lazyboe-transfer on a bundle without transfer statistics).
+void check_planner_specs(const PlanningContext& context, std::vector<PlannerSpec>& specs);
 
 struct RunRecord {
   std::string planner;

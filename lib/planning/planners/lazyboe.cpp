@@ -9,16 +9,18 @@
 namespace lazyboe {
 namespace {
 
+constexpr double kTransferIndex = 1;  // lazy_model's index of "transfer"
+
 class LazySearch : public BundleSearch {
  public:
   LazySearch(const PlanningContext& ctx, SimulatorWorkspace& ws, const PlanningProblem& p,
              double theta, RolloutPool* pool, const ParameterValues& values)
       : BundleSearch(ctx, ws, p, theta, pool),
-        transfer_(values.get("lazy_model") == kTransfer),
+        transfer_(values.get("lazy_model") == kTransferIndex),
         rng_(p.seed, 0) {}
 
   static void check_context(const PlanningContext& ctx, const ParameterValues& values) {
-    if (values.get("lazy_model") == kTransfer && !ctx.bundle->has_transfer()) {
+    if (values.get("lazy_model") == kTransferIndex && !ctx.bundle->has_transfer()) {
       fail(ctx.bundle->path(),
            "has no transfer statistics, which lazyboe's lazy_model transfer needs (run "
            "lazyboe-perturb --replace with this version)");
@@ -98,7 +100,6 @@ class LazySearch : public BundleSearch {
   void take_lazily(int v, uint32_t e, size_t k);
   bool realize(int x, long k = -1);
 
-  static constexpr double kTransfer = 1;  // lazy_model's index of "transfer"
   const bool transfer_;
   Random rng_;
   bool exhaustive_ = false;
@@ -179,6 +180,7 @@ PlannerInfo lazyboe_planner_info() {
       "where a lazy edge ends: its stored end (the paper) or the node moved by the edge's "
       "displacement, with P_lazy_prop under transfer";
   info.parameters = {theta_parameter(), model};
+  info.study_variants = {{"lazyboe", {}}, {"lazyboe-transfer", {{"lazy_model", kTransferIndex}}}};
   info.make = [](const ParameterValues& v) {
     return std::make_unique<BundlePlanner<LazySearch>>(v, "lazyboe", true);
   };
