@@ -57,8 +57,6 @@ class LazySpSearch {
   bool push(Predicted x, double h);
   void validate(int goal);
   void grow();
-  void sample(JointVector& x);
-  int nearest(const JointVector& x);
   int add_real(const JointVector& q, int parent, int64_t edge, int command, double cost);
   void found(int node, const char* by);
   std::vector<PathStep> path_to(int node);
@@ -232,8 +230,8 @@ void LazySpSearch::validate(int goal) {
 void LazySpSearch::grow() {
   const int n = ctx_.sim.robot.dof;
   JointVector x(n);
-  sample(x);
-  const int from = nearest(x);
+  sample_state(ctx_, s_.problem(), set_.goal_bias, rng_, x);
+  const int from = nearest_live(s_.nodes(), x);
   std::vector<double> knots;
   const double duration = sample_command_profile(ctx_.sim.robot, ctx_.command, rng_, knots);
   const CommandProfile profile{knots.data(), static_cast<int>(knots.size() / n), n, duration};
@@ -246,29 +244,6 @@ void LazySpSearch::grow() {
   if (s_.in_goal(s_.node(c).h)) found(c, "growth");
 }
 
-void LazySpSearch::sample(JointVector& x) {
-  const PlanningProblem& p = s_.problem();
-  if (p.goal.kind == Goal::Kind::Joint && rng_.uniform() < set_.goal_bias) {
-    x = p.goal.q;
-    return;
-  }
-  for (int i = 0; i < x.size(); ++i)
-    x[i] = rng_.uniform(ctx_.sample_lower[i], ctx_.sample_upper[i]);
-}
-
-int LazySpSearch::nearest(const JointVector& x) {
-  int best = 0;
-  double best_d = std::numeric_limits<double>::infinity();
-  const std::vector<SearchNode>& nodes = s_.nodes();
-  for (size_t v = 0; v < nodes.size(); ++v) {
-    const double d = (nodes[v].q - x).squaredNorm();
-    if (d < best_d) {
-      best_d = d;
-      best = static_cast<int>(v);
-    }
-  }
-  return best;
-}
 
 int LazySpSearch::add_real(const JointVector& q, int parent, int64_t edge, int command,
                            double cost) {

@@ -65,20 +65,24 @@ PlanResult TreeSearch::run() {
   return result;
 }
 
-void TreeSearch::sample(JointVector& x) {
-  const PlanningProblem& p = s_.problem();
-  if (p.goal.kind == Goal::Kind::Joint && rng_.uniform() < goal_bias_) {
+void sample_state(const PlanningContext& ctx, const PlanningProblem& p, double goal_bias,
+                  Random& rng, JointVector& x) {
+  if (p.goal.kind == Goal::Kind::Joint && rng.uniform() < goal_bias) {
     x = p.goal.q;
     return;
   }
-  for (int i = 0; i < x.size(); ++i)
-    x[i] = rng_.uniform(ctx_.sample_lower[i], ctx_.sample_upper[i]);
+  for (int i = 0; i < x.size(); ++i) x[i] = rng.uniform(ctx.sample_lower[i], ctx.sample_upper[i]);
 }
 
-int TreeSearch::nearest(const JointVector& x) {
+void TreeSearch::sample(JointVector& x) {
+  sample_state(ctx_, s_.problem(), goal_bias_, rng_, x);
+}
+
+int TreeSearch::nearest(const JointVector& x) { return nearest_live(s_.nodes(), x); }
+
+int nearest_live(const std::vector<SearchNode>& nodes, const JointVector& x) {
   int best = 0;
   double best_d = std::numeric_limits<double>::infinity();
-  const std::vector<SearchNode>& nodes = s_.nodes();
   for (size_t v = 0; v < nodes.size(); ++v) {
     if (nodes[v].pruned || nodes[v].inactive) continue;
     const double d = (nodes[v].q - x).squaredNorm();

@@ -80,6 +80,14 @@ class TreePlanner : public Planner {
   const PlanningContext* context_ = nullptr;
 };
 
+// A goal-biased sample: a joint goal with probability goal_bias, else uniform in the context's
+// sampling box.
+void sample_state(const PlanningContext& ctx, const PlanningProblem& problem, double goal_bias,
+                  Random& rng, JointVector& x);
+
+// The node nearest to x (joint space) that is neither pruned nor inactive.
+int nearest_live(const std::vector<SearchNode>& nodes, const JointVector& x);
+
 // goal_bias, as RRT and SST (ours and OMPL's) declare it.
 ParameterSpec goal_bias_parameter();
 
