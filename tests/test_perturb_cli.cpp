@@ -610,9 +610,10 @@ TEST(PerturbCli, ExtendRerunRefuseAndReplace) {
 }
 
 // An analysis written before the transfer statistics (the same file without their three
-// datasets, as an older lazyboe-perturb wrote it) opens everywhere without them, and
-// lazyboe-perturb redoes it whole to the numbers of a straight run.
-TEST(PerturbCli, AnalysisWithoutTransferStatisticsOpensAndIsRecomputed) {
+// datasets, as an older lazyboe-perturb wrote it) opens everywhere without them;
+// lazyboe-perturb keeps it (saying what it lacks), refuses to extend it in place, and redoes it
+// with --replace to the numbers of a straight run.
+TEST(PerturbCli, AnalysisWithoutTransferStatisticsOpensAndIsKeptOrReplaced) {
   const std::string& input = input_bundle(kSmallEdges, kSmallSeed);
   const Bundle original = read_bundle(input);
   const std::string dir = fresh_dir("old-analysis");
@@ -662,26 +663,42 @@ TEST(PerturbCli, AnalysisWithoutTransferStatisticsOpensAndIsRecomputed) {
     EXPECT_EQ(q.exit_code, 0) << describe(q);
     EXPECT_TRUE(contains(q.out, "\"old\"")) << describe(q);
   }
-  // Continuing it with its own settings (complete: nothing to do for the old counts) and
-  // extending it both recompute it whole, saying so once.
-  for (const std::string p : {"4", "8"}) {
-    SCOPED_TRACE("to p = " + p);
+  // Continuing it with its own settings: nothing to do; it is kept, and the note says what it
+  // lacks, once.
+  {
     make_old();
     const CommandResult r =
-        perturb_tool({"--bundle", path, "--perturbations", p, "--seed", "3", "--threads", "2"});
+        perturb_tool({"--bundle", path, "--perturbations", "4", "--seed", "3", "--threads", "2"});
     ASSERT_EQ(r.exit_code, 0) << describe(r);
-    EXPECT_TRUE(contains(r.err, "no transfer statistics")) << describe(r);
-    EXPECT_TRUE(contains(r.err, "recomputing")) << describe(r);
-    size_t notes = 0;  // once, beside the progress lines
+    size_t notes = 0;
     for (size_t at = r.err.find("no transfer statistics"); at != std::string::npos;
          at = r.err.find("no transfer statistics", at + 1))
       ++notes;
     EXPECT_EQ(notes, 1u) << r.err;
+    EXPECT_TRUE(contains(r.err, "--replace")) << r.err;
     const Bundle b = read_bundle(path);
     EXPECT_TRUE(b.perturbation.complete);
+    EXPECT_FALSE(b.perturbation.has_transfer);
+    expect_same_edges(b, original);
+  }
+  // Extending it in place is refused (it would be redone, checkpointing an incomplete analysis
+  // over the complete one); --replace redoes it, to a straight run's numbers.
+  {
+    make_old();
+    const auto before = snapshot(dir);
+    const CommandResult more =
+        perturb_tool({"--bundle", path, "--perturbations", "8", "--seed", "3", "--threads", "2"});
+    expect_one_line_error(more, {"--replace", path, "transfer statistics"});
+    EXPECT_TRUE(snapshot(dir) == before);
+    const CommandResult r = perturb_tool(
+        {"--bundle", path, "--perturbations", "8", "--seed", "3", "--threads", "2", "--replace"});
+    ASSERT_EQ(r.exit_code, 0) << describe(r);
+    const Bundle b = read_bundle(path);
+    EXPECT_TRUE(b.perturbation.complete);
+    EXPECT_TRUE(b.perturbation.has_transfer);
     EXPECT_EQ(check_invariants(b), kSmallEdges);
     expect_same_perturbation(b.perturbation,
-                             reference(input, {"--perturbations", p, "--seed", "3"}).perturbation);
+                             reference(input, {"--perturbations", "8", "--seed", "3"}).perturbation);
     expect_same_edges(b, original);
   }
   // Fewer perturbations than it holds, or other settings, are refused as for any analysis.

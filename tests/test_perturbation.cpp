@@ -246,10 +246,11 @@ TEST(Perturbation, TransferStatisticsAreThoseOfFreshRollouts) {
   EXPECT_LT(sum_transfer, 0.2 * sum_stored);
 }
 
-// An analysis written before the transfer statistics (none stored) is redone whole with its
-// own settings when continued or extended, to the numbers of a straight run; what is refused
-// for any analysis is still refused.
-TEST(Perturbation, AnalysisWithoutTransferIsRecomputed) {
+// An analysis written before the transfer statistics (none stored) is kept when complete with
+// the same settings, refused when it would have to be extended (never redone in place), and
+// redone with --replace to the numbers of a straight run; what is refused for any analysis is
+// still refused.
+TEST(Perturbation, AnalysisWithoutTransferIsKeptOrReplaced) {
   Scene scene("table");
   const Bundle base = small_bundle(scene, 16);
   PerturbSettings s;
@@ -271,7 +272,18 @@ TEST(Perturbation, AnalysisWithoutTransferIsRecomputed) {
     EXPECT_FALSE(old.perturbation.has_transfer);
     PerturbSettings more = s;
     more.perturbations = p;
-    EXPECT_TRUE(prepare_perturbation(old, more, false, "x.h5"));
+    if (p == s.perturbations) {
+      const Perturbation kept = q;
+      EXPECT_TRUE(prepare_perturbation(old, more, false, "x.h5"));  // it lacks them
+      EXPECT_TRUE(q.complete);
+      EXPECT_FALSE(q.has_transfer);
+      EXPECT_EQ(q.done, kept.done);
+      EXPECT_EQ(q.p_lazy_prop, kept.p_lazy_prop);
+    } else {
+      EXPECT_THROW(prepare_perturbation(old, more, false, "x.h5"), Error);
+      EXPECT_FALSE(q.has_transfer);
+    }
+    EXPECT_FALSE(prepare_perturbation(old, more, true, "x.h5"));  // --replace
     EXPECT_TRUE(q.has_transfer);
     EXPECT_FALSE(q.complete);
     EXPECT_EQ(q.done, std::vector<uint64_t>(old.size(), 0));

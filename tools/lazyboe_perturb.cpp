@@ -60,7 +60,8 @@ int main(int argc, char** argv) {
     if (prepare_perturbation(bundle, s, replace, bundle_path) && !control.quiet) {
       std::fprintf(stderr,
                    "lazyboe-perturb: %s: its analysis has no transfer statistics (written by an "
-                   "older lazyboe): recomputing it whole with the same settings\n",
+                   "older lazyboe), which lazyboe's lazy_model transfer needs; --replace redoes "
+                   "it with them\n",
                    bundle_path.c_str());
     }
     if (bundle.perturbation.complete) {

@@ -106,6 +106,12 @@ void report_load(const Options& o, const PlanningSession& session) {
       bundle.memory_mapped() ? "memory-mapped" : "read into memory", resident_memory_mib());
 }
 
+// A query id names its trajectory file: it must stay inside --trajectory-dir.
+bool usable_file_name(const std::string& id) {
+  return !id.empty() && id != "." && id != ".." && id.find('/') == std::string::npos &&
+         id.find('\0') == std::string::npos;
+}
+
 // One query line: its result line, and what the summary needs. Nothing escapes it (it runs
 // inside an OpenMP job).
 std::pair<std::string, Outcome> answer(const Job& job, const std::string& text, int line,
@@ -117,6 +123,10 @@ std::pair<std::string, Outcome> answer(const Job& job, const std::string& text, 
     const Simulator& sim = job.session.sim;
     const Query q = parse_query(text, line, sim.robot, sim, ws, job.defaults, id);
     o.planner = q.planner;
+    if (job.mode == TrajectoryOutput::Csv && !usable_file_name(q.id)) {
+      fail("line " + std::to_string(line) + ": id",
+           "'" + q.id + "' cannot name a file in --trajectory-dir (no '/', not . or ..)");
+    }
     const PlanResult r = plan(job.context, ws, q.planner, q.parameters, q.problem, &pool);
     Trajectory traj;
     if (r.success)

@@ -109,7 +109,6 @@ bool prepare_perturbation(Bundle& b, const PerturbSettings& s, bool replace,
                           const std::string& path) {
   Perturbation& p = b.perturbation;
   const size_t n = b.size();
-  bool recompute = false;
   if (p.present && !replace) {
     if (p.theta != s.theta) {
       fail(path, "holds a perturbation analysis for theta " + exact(p.theta) +
@@ -129,9 +128,18 @@ bool prepare_perturbation(Bundle& b, const PerturbSettings& s, bool replace,
                                [&](uint64_t d) { return d >= s.perturbations; });
       return false;
     }
-    // Written before the transfer statistics: the rollouts done so far would have to be
-    // simulated again for them anyway, so the analysis is redone whole with the same settings.
-    recompute = true;
+    // Written before the transfer statistics: kept when there is nothing to add (it still
+    // serves the stored lazy model), never redone in place (a checkpoint would replace a
+    // complete analysis with an incomplete one).
+    const bool complete = std::all_of(p.done.begin(), p.done.end(),
+                                      [&](uint64_t d) { return d >= s.perturbations; });
+    if (complete && s.perturbations == p.perturbations) {
+      p.complete = true;
+      return true;
+    }
+    fail(path, "holds a perturbation analysis written before the transfer statistics, which "
+               "cannot be extended or continued; use --replace to redo it (the file keeps its "
+               "analysis until the new one's first checkpoint)");
   }
   p = Perturbation{};
   p.present = true;
@@ -150,7 +158,7 @@ bool prepare_perturbation(Bundle& b, const PerturbSettings& s, bool replace,
   p.transfer_max_error.assign(n, std::numeric_limits<double>::quiet_NaN());
   p.p_lazy_prop_transfer.assign(n, 0.0);
   p.complete = n == 0;
-  return recompute;
+  return false;
 }
 
 PerturbOutcome run_perturbation(const Simulator& sim, Bundle& b, const PerturbSettings& s,

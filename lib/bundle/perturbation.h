@@ -66,9 +66,10 @@ void perturb_edge(const Simulator& sim, SimulatorWorkspace& ws, const Bundle& bu
 // Sets up bundle.perturbation for `settings`: keeps the existing counts when theta and seed
 // match and p does not shrink (they are extended), starts afresh when `replace` is set, and
 // refuses otherwise with a message naming the difference. An analysis without the transfer
-// statistics (written by an older lazyboe) that would otherwise be kept is recomputed from
-// scratch with the same settings (its counts cannot be extended consistently); the return
-// value says so (true: recomputing such an analysis).
+// statistics (written by an older lazyboe) is kept as it is when complete with these settings
+// (the return value is then true: it lacks them), and refused, pointing to --replace, when it
+// would have to be extended or continued: its counts cannot be extended consistently, and
+// redoing it in place would checkpoint an incomplete analysis over a complete one.
 bool prepare_perturbation(Bundle& bundle, const PerturbSettings& settings, bool replace,
                           const std::string& path);
 

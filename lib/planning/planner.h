@@ -41,6 +41,8 @@ class Planner {
   // sampling box) and resolves parameters whose default comes from it. Throws Error naming
   // what is missing. The context must outlive the planner's solves.
   virtual void setup(const PlanningContext& context) = 0;
+  // A planner keeps a pointer to its context: a temporary would dangle.
+  void setup(const PlanningContext&& context) = delete;
 
   // Plans one problem (validate_problem first: a planner assumes a valid one) until its
   // termination condition. `ws` is the calling thread's workspace; `pool`, when given and of

@@ -33,6 +33,7 @@ struct Settings {
 struct Predicted {
   JointVector q;
   double g = 0;       // real cost to the source plus the predicted edges' displacements and risk
+  double length = 0;  // the same without the risk: a lower bound of the arc length (pruning)
   int parent = -1;    // -1: a source
   uint32_t edge = 0;  // from the parent
   int real = -1;      // a source's real node
@@ -141,6 +142,7 @@ int LazySpSearch::search(size_t& expansions) {
     Predicted x;
     x.q = n.q;
     x.g = n.cost;
+    x.length = n.cost;
     x.real = static_cast<int>(v);
     push(x, n.h);
   }
@@ -172,11 +174,12 @@ int LazySpSearch::expand(int p) {
     Predicted c;
     c.q = x.q + step;
     if (!within_limits(c.q)) continue;
-    c.g = x.g + step.norm() + risk(e);  // |qf - q0| is a lower bound of the arc length
+    c.g = x.g + step.norm() + risk(e);
+    c.length = x.length + step.norm();  // |qf - q0| is a lower bound of the arc length
     c.parent = p;
     c.edge = e;
     const double h = s_.heuristic(c.q);
-    if (prunable(c.g, h) || !push(c, h)) continue;
+    if (prunable(c.length, h) || !push(c, h)) continue;
     ++s_.result().counters.lazy_edges;
     if (s_.in_goal(h) && c.g < goal_g) {
       goal = static_cast<int>(preds_.size()) - 1;
@@ -292,8 +295,8 @@ bool LazySpSearch::within_limits(const JointVector& q) const {
   return (q.array() >= robot.q_min.array()).all() && (q.array() <= robot.q_max.array()).all();
 }
 
-// A 64-bit hash of the cell's integer coordinates (two cells sharing a hash would merge: about
-// one chance in 10^10 per round of a million states).
+// A 64-bit hash of the cell's integer coordinates (two cells sharing a hash would merge: for a
+// round of a million states about one chance in 4 10^7, and then one state is lost).
 uint64_t LazySpSearch::cell(const JointVector& q) const {
   uint64_t h = 0x9E3779B97F4A7C15ULL;
   for (int i = 0; i < q.size(); ++i) {
@@ -355,11 +358,12 @@ PlannerInfo lazysp_planner_info() {
       "expansion_limit", 20000, 1, false,
       "predicted states expanded per round of the lazy search before it gives the growth a turn");
   limit.type = ParameterType::Integer;
+  limit.upper = 1e9;
   info.parameters = {
       theta_parameter(),
       real_parameter("epsilon", 2.0, 1, false,
                      "heuristic weight of the lazy search (f = g + epsilon h; 1: A*)"),
-      real_parameter("resolution", 0.05, 0, true,
+      real_parameter("resolution", 0.05, 1e-6, false,  // a floor keeps the cell index finite
                      "cell side, rad, below which predicted states are merged"),
       real_parameter(
           "risk_weight", 0.5, 0, false,
