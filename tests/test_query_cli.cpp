@@ -767,6 +767,27 @@ bool read_csv(const std::string& path, std::string& header,
   return true;
 }
 
+// A query id names its CSV file: an id that would leave --trajectory-dir gets an error result
+// (the others are answered) and writes nothing outside.
+TEST(QueryCli, CsvTrajectoryIdsMustNameAFileInTheDirectory) {
+  const Fixture& f = fixture();
+  const std::string dir = fresh_dir("csv-ids");
+  const std::string traj_dir = dir + "/trajectories";
+  const std::vector<json> queries = {query("../escape", f.a, f.b, "boe", 2, true),
+                                     query("..", f.a, f.b, "boe", 2, true),
+                                     query("fine", f.a, f.b, "boe", 2, true)};
+  const ToolRun t = run_batch("csv-ids", queries,
+                              {"--trajectories", "csv", "--trajectory-dir", traj_dir, "--quiet"});
+  ASSERT_EQ(t.results.size(), 3u) << describe(t.r);
+  for (size_t i = 0; i < 2; ++i) {
+    EXPECT_TRUE(contains(t.results[i].value("error", ""), "cannot name a file"))
+        << t.results[i].dump();
+  }
+  EXPECT_TRUE(t.results[2].value("success", false)) << t.results[2].dump();
+  EXPECT_FALSE(fs::exists(dir + "/escape.csv"));
+  EXPECT_EQ(files_in(traj_dir), std::vector<std::string>{"fine.csv"});
+}
+
 TEST(QueryCli, CsvTrajectoriesHaveTheInlineRows) {
   const Fixture& f = fixture();
   const std::vector<json> queries = quick_queries();

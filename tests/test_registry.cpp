@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <string>
@@ -49,6 +50,9 @@ TEST(Registry, SchemaListsExactlyTheRegisteredPlanners) {
   EXPECT_EQ(planner_registry().front().name, "lazyboe");  // the default planner
 }
 
+// A double: with a float default, json::value would read the bound as a float.
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
 TEST(Registry, SchemaDeclaresEveryParameterWithItsRange) {
   const nlohmann::json props = query_schema().at("properties");
   for (const PlannerInfo& info : planner_registry()) {
@@ -66,10 +70,10 @@ TEST(Registry, SchemaDeclaresEveryParameterWithItsRange) {
                                                             : "number";
       EXPECT_EQ(s.value("type", ""), type);
       if (std::isfinite(p.lower)) {
-        EXPECT_EQ(s.value(p.lower_exclusive ? "exclusiveMinimum" : "minimum", NAN), p.lower);
+        EXPECT_EQ(s.value(p.lower_exclusive ? "exclusiveMinimum" : "minimum", kNaN), p.lower);
       }
       if (std::isfinite(p.upper)) {
-        EXPECT_EQ(s.value("maximum", NAN), p.upper);
+        EXPECT_EQ(s.value("maximum", kNaN), p.upper);
       }
       EXPECT_FALSE(p.description.empty());
       EXPECT_TRUE(p.has_fixed_default() || !p.default_from.empty());
