@@ -7,14 +7,15 @@ namespace lazyboe {
 
 namespace {
 
-// nanoflann's view of the edge starts (or ends).
+// nanoflann's view of the edge starts (or ends): rows of dof values. The row pointer is taken
+// once, not per coordinate: nanoflann reads a coordinate at a time in its inner loops.
 struct StartPoints {
   const BundleView* bundle;
   EdgePoint point;
+  const double* rows;
+  size_t dof;
   size_t kdtree_get_point_count() const { return bundle->size(); }
-  double kdtree_get_pt(size_t idx, size_t dim) const {
-    return (point == EdgePoint::Start ? bundle->q0(idx) : bundle->qf(idx))[dim];
-  }
+  double kdtree_get_pt(size_t idx, size_t dim) const { return rows[idx * dof + dim]; }
   template <class BBox>
   bool kdtree_get_bbox(BBox&) const {
     return false;
@@ -30,7 +31,9 @@ struct EdgeStartIndex::Impl {
   StartPoints points;
   Tree tree;
   Impl(const BundleView& b, EdgePoint point)
-      : points{&b, point}, tree(b.dof(), points, nanoflann::KDTreeSingleIndexAdaptorParams(16)) {
+      : points{&b, point, b.size() == 0 ? nullptr : (point == EdgePoint::Start ? b.q0(0) : b.qf(0)),
+               static_cast<size_t>(b.dof())},
+        tree(b.dof(), points, nanoflann::KDTreeSingleIndexAdaptorParams(16)) {
     tree.buildIndex();
   }
 };
