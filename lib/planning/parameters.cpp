@@ -62,6 +62,17 @@ std::string ParameterSpec::check(double value) const {
   return "";
 }
 
+ParameterSpec real_parameter(const std::string& name, double default_value, double lower,
+                             bool lower_exclusive, const std::string& description) {
+  ParameterSpec p;
+  p.name = name;
+  p.default_value = default_value;
+  p.lower = lower;
+  p.lower_exclusive = lower_exclusive;
+  p.description = description;
+  return p;
+}
+
 double ParameterValues::get(const std::string& name) const {
   const auto it = values_.find(name);
   if (it == values_.end()) fail(name, "parameter not set");

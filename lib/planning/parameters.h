@@ -38,6 +38,10 @@ struct ParameterSpec {
   std::string check(double value) const;
 };
 
+// A real parameter with a fixed default and a lower bound (exclusive or not).
+ParameterSpec real_parameter(const std::string& name, double default_value, double lower,
+                             bool lower_exclusive, const std::string& description);
+
 // Values by parameter name.
 class ParameterValues {
  public:

@@ -247,7 +247,6 @@ void LazySpSearch::grow() {
   if (s_.in_goal(s_.node(c).h)) found(c, "growth");
 }
 
-
 int LazySpSearch::add_real(const JointVector& q, int parent, int64_t edge, int command,
                            double cost) {
   SearchNode n;
@@ -333,17 +332,6 @@ class LazySpPlanner : public Planner {
   Settings settings_;
   const PlanningContext* context_ = nullptr;
 };
-
-ParameterSpec real_parameter(const char* name, double value, double lower, bool exclusive,
-                             const char* description) {
-  ParameterSpec p;
-  p.name = name;
-  p.default_value = value;
-  p.lower = lower;
-  p.lower_exclusive = exclusive;
-  p.description = description;
-  return p;
-}
 
 }  // namespace
 

@@ -79,23 +79,12 @@ class SstSearch : public TreeSearch {
 }  // namespace
 
 ParameterSpec selection_radius_parameter() {
-  ParameterSpec p;
-  p.name = "selection_radius";
-  p.default_value = 0.2;
-  p.lower = 0;
-  p.lower_exclusive = true;
-  p.description = "SST's selection radius delta_BN, rad";
-  return p;
+  return real_parameter("selection_radius", 0.2, 0, true, "SST's selection radius delta_BN, rad");
 }
 
 ParameterSpec pruning_ratio_parameter() {
-  ParameterSpec p;
-  p.name = "pruning_ratio";
-  p.default_value = 1.0;
-  p.lower = 0;
-  p.lower_exclusive = true;
-  p.description = "SST's pruning radius delta_s as a multiple of the selection radius";
-  return p;
+  return real_parameter("pruning_ratio", 1.0, 0, true,
+                        "SST's pruning radius delta_s as a multiple of the selection radius");
 }
 
 PlannerInfo sst_planner_info() {
