@@ -111,4 +111,20 @@ void expect_same_edge_arrays(const Bundle& a, const Bundle& b) {
   EXPECT_TRUE(same_array("sample_dq", a.sample_dq, b.sample_dq));
 }
 
+void expect_same_perturbation_arrays(const Perturbation& a, const Perturbation& b) {
+  EXPECT_TRUE(same_array("perturbation/done", a.done, b.done));
+  EXPECT_TRUE(same_array("perturbation/valid", a.valid, b.valid));
+  EXPECT_TRUE(same_array("perturbation/lazy", a.lazy, b.lazy));
+  EXPECT_TRUE(same_array("perturbation/collision", a.collision, b.collision));
+  EXPECT_TRUE(same_array("perturbation/max_error", a.max_error, b.max_error));
+  EXPECT_TRUE(same_array("perturbation/p_lazy_prop", a.p_lazy_prop, b.p_lazy_prop));
+  EXPECT_TRUE(same_array("perturbation/p_collision", a.p_collision, b.p_collision));
+  EXPECT_EQ(a.has_transfer, b.has_transfer);
+  EXPECT_TRUE(same_array("perturbation/transfer_lazy", a.transfer_lazy, b.transfer_lazy));
+  EXPECT_TRUE(
+      same_array("perturbation/transfer_max_error", a.transfer_max_error, b.transfer_max_error));
+  EXPECT_TRUE(same_array("perturbation/p_lazy_prop_transfer", a.p_lazy_prop_transfer,
+                         b.p_lazy_prop_transfer));
+}
+
 }  // namespace lazyboe::test

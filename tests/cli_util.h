@@ -66,4 +66,8 @@ template <typename T>
 // The edge count and every per-edge array of the two bundles are identical, bit for bit.
 void expect_same_edge_arrays(const Bundle& a, const Bundle& b);
 
+// Every per-edge dataset of the two perturbation analyses is identical, bit for bit (the
+// transfer statistics too, and whether they are there).
+void expect_same_perturbation_arrays(const Perturbation& a, const Perturbation& b);
+
 }  // namespace lazyboe::test

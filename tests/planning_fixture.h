@@ -63,7 +63,7 @@ struct PlanningFixture {
   CollisionModel collision;
   Simulator sim;
   BundleView view;
-  EdgeStartIndex index{view};
+  EdgeIndex index{view};
   JointVector a, b;  // an easy pair: two edge starts 0.35-0.45 rad apart near the region's centre
   JointVector c;     // an edge start 0.7-0.85 rad from a: paths of several steps
 

@@ -193,19 +193,7 @@ void expect_same_perturbation(const Perturbation& a, const Perturbation& b, bool
   EXPECT_TRUE(same_double(a.theta, b.theta)) << a.theta << " vs " << b.theta;
   EXPECT_EQ(a.perturbations, b.perturbations);
   EXPECT_EQ(a.seed, b.seed);
-  EXPECT_TRUE(same_array("perturbation/done", a.done, b.done));
-  EXPECT_TRUE(same_array("perturbation/valid", a.valid, b.valid));
-  EXPECT_TRUE(same_array("perturbation/lazy", a.lazy, b.lazy));
-  EXPECT_TRUE(same_array("perturbation/collision", a.collision, b.collision));
-  EXPECT_TRUE(same_array("perturbation/max_error", a.max_error, b.max_error));
-  EXPECT_TRUE(same_array("perturbation/p_lazy_prop", a.p_lazy_prop, b.p_lazy_prop));
-  EXPECT_TRUE(same_array("perturbation/p_collision", a.p_collision, b.p_collision));
-  EXPECT_EQ(a.has_transfer, b.has_transfer);
-  EXPECT_TRUE(same_array("perturbation/transfer_lazy", a.transfer_lazy, b.transfer_lazy));
-  EXPECT_TRUE(
-      same_array("perturbation/transfer_max_error", a.transfer_max_error, b.transfer_max_error));
-  EXPECT_TRUE(same_array("perturbation/p_lazy_prop_transfer", a.p_lazy_prop_transfer,
-                         b.p_lazy_prop_transfer));
+  expect_same_perturbation_arrays(a, b);
   EXPECT_NEAR(a.simulated_seconds, b.simulated_seconds,
               1e-9 * std::max(1.0, std::abs(b.simulated_seconds)));
   if (work) {
@@ -697,8 +685,8 @@ TEST(PerturbCli, AnalysisWithoutTransferStatisticsOpensAndIsKeptOrReplaced) {
     EXPECT_TRUE(b.perturbation.complete);
     EXPECT_TRUE(b.perturbation.has_transfer);
     EXPECT_EQ(check_invariants(b), kSmallEdges);
-    expect_same_perturbation(b.perturbation,
-                             reference(input, {"--perturbations", "8", "--seed", "3"}).perturbation);
+    expect_same_perturbation(
+        b.perturbation, reference(input, {"--perturbations", "8", "--seed", "3"}).perturbation);
     expect_same_edges(b, original);
   }
   // Fewer perturbations than it holds, or other settings, are refused as for any analysis.

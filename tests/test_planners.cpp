@@ -22,11 +22,11 @@
 #include <vector>
 
 #include "cli_util.h"
-#include "lazyboe/bundle/builder.h"
 #include "lazyboe/bundle/bundle.h"
 #include "lazyboe/bundle/bundle_view.h"
 #include "lazyboe/common/error.h"
 #include "lazyboe/planning/neighbour_index.h"
+#include "lazyboe/planning/planning_session.h"
 #include "lazyboe/planning/problem.h"
 #include "lazyboe/planning/registry.h"
 #include "lazyboe/planning/rollout_scheduler.h"
@@ -80,19 +80,6 @@ PlanningProblem library_problem(const JointVectorRef& start, const JointVectorRe
   return p;
 }
 
-// The context a planning session makes for a bundle: theta, sampling box and command family
-// from its header.
-PlanningContext library_context(const PlanningFixture& f, const BundleView& view,
-                                const EdgeStartIndex& index) {
-  const BuildSettings settings = settings_from_header(view.header());
-  PlanningContext c{f.sim, &view, &index};
-  c.theta = view.has_perturbation() ? view.perturbation_theta() : view.header().design_theta;
-  c.sample_lower = settings.region_lower;
-  c.sample_upper = settings.region_upper;
-  c.command = settings.command;
-  return c;
-}
-
 constexpr int kSampleEvery = 10;  // 0.01 s at 1 kHz, the tool's default
 
 // The easy problem a -> b with every planner, through the library, in parallel threads (one
@@ -100,7 +87,7 @@ constexpr int kSampleEvery = 10;  // 0.01 s at 1 kHz, the tool's default
 const std::vector<LibraryRun>& library_runs() {
   static const std::vector<LibraryRun> runs = [] {
     const Fixture& f = fixture();
-    const PlanningContext context = library_context(f, f.view, f.index);
+    const PlanningContext context = bundle_context(f.sim, f.view, f.index);
     std::vector<LibraryRun> out(kPlanners.size());
     std::vector<std::thread> threads;
     for (size_t i = 0; i < kPlanners.size(); ++i) {
@@ -187,7 +174,7 @@ TEST_P(EveryRegisteredPlanner, SolvesAnEasyProblemWithAValidPath) {
   std::string why;
   if (!info.available(&why)) GTEST_SKIP() << name << ": " << why;
   const Fixture& f = fixture();
-  const PlanningContext context = library_context(f, f.view, f.index);
+  const PlanningContext context = bundle_context(f.sim, f.view, f.index);
   PlanningProblem problem = library_problem(f.a, f.b, 5);
   problem.termination.stop_at_first = true;
   const std::unique_ptr<Planner> planner = make_planner(name, {});
@@ -309,7 +296,7 @@ TEST(Planners, OutputsAreMadeOfSimulatedEdgesOnly) {
 
 TEST(Planners, ARolloutPoolChangesNothingButWhoSimulates) {
   const Fixture& f = fixture();
-  const PlanningContext context = library_context(f, f.view, f.index);
+  const PlanningContext context = bundle_context(f.sim, f.view, f.index);
   for (const std::string planner : {"lazyboe", "boe"}) {
     SCOPED_TRACE(planner);
     PlanningProblem p = library_problem(f.a, f.c, 10);
@@ -347,7 +334,7 @@ TEST(Planners, ARolloutPoolChangesNothingButWhoSimulates) {
 TEST(Planners, LazyBoEWithTransferSolvesWithValidPaths) {
   const Fixture& f = fixture();
   ASSERT_TRUE(f.view.has_transfer());
-  const PlanningContext context = library_context(f, f.view, f.index);
+  const PlanningContext context = bundle_context(f.sim, f.view, f.index);
   const ParameterValues transfer = {{"lazy_model", 1}};
   uint64_t simulations[2] = {0, 0};
   for (const JointVector* goal : {&f.b, &f.c}) {
@@ -383,8 +370,8 @@ TEST(Planners, LazyBoEWithTransferRefusesABundleWithoutTransferStatistics) {
   const BundleView view = BundleView::from_memory(std::make_shared<const Bundle>(old), "old");
   ASSERT_TRUE(view.has_perturbation());
   ASSERT_FALSE(view.has_transfer());
-  const EdgeStartIndex index(view);
-  const PlanningContext context = library_context(f, view, index);
+  const EdgeIndex index(view);
+  const PlanningContext context = bundle_context(f.sim, view, index);
   SimulatorWorkspace ws(f.sim);
   try {
     plan(context, ws, "lazyboe", {{"lazy_model", 1}}, library_problem(f.a, f.b, 1));
@@ -400,8 +387,8 @@ TEST(Planners, LazyBoEOnABundleWithoutPerturbationIsRefused) {
   const BundleView plain = BundleView::from_memory(f.unperturbed, "the unperturbed bundle");
   EXPECT_FALSE(plain.has_perturbation());
   // And through the library.
-  const EdgeStartIndex plain_index(plain);
-  const PlanningContext context = library_context(f, plain, plain_index);
+  const EdgeIndex plain_index(plain);
+  const PlanningContext context = bundle_context(f.sim, plain, plain_index);
   SimulatorWorkspace ws(f.sim);
   try {
     plan(context, ws, "lazyboe", {}, library_problem(f.a, f.b, 1));
@@ -422,7 +409,7 @@ TEST(Planners, StartOrGoalOutsideTheCoverageFailsWithAReason) {
   ASSERT_EQ(far_goal.size(), 7) << "no collision-free state far from the bundle's ends";
 
   // Library: a clear failure at once, not a timeout.
-  const PlanningContext context = library_context(f, f.view, f.index);
+  const PlanningContext context = bundle_context(f.sim, f.view, f.index);
   SimulatorWorkspace ws(f.sim);
   for (const std::string planner : {"lazyboe", "boe"}) {
     for (bool start_is_far : {true, false}) {
@@ -475,8 +462,8 @@ TEST(Planners, ALazyChainWithoutProgressEnds) {
   p.p_lazy_prop_transfer = {1.0};
   const BundleView view =
       BundleView::from_memory(std::make_shared<const Bundle>(one), "one self-loop edge");
-  const EdgeStartIndex index(view);
-  const PlanningContext context = library_context(f, view, index);
+  const EdgeIndex index(view);
+  const PlanningContext context = bundle_context(f.sim, view, index);
 
   const JointVector start = f.edge_start(k);
   JointVector goal = start;
@@ -495,13 +482,13 @@ TEST(Planners, ALazyChainWithoutProgressEnds) {
 // ------------------------------------------------------------------------------------------
 
 // The context a planning session makes: with the k-d tree over edge end states too.
-const EdgeStartIndex& end_index() {
-  static const EdgeStartIndex ends(fixture().view, EdgePoint::End);
+const EdgeIndex& end_index() {
+  static const EdgeIndex ends(fixture().view, EdgePoint::End);
   return ends;
 }
 
 PlanningContext session_context(const Fixture& f, const Simulator& sim) {
-  PlanningContext c = library_context(f, f.view, f.index);
+  PlanningContext c = bundle_context(f.sim, f.view, f.index);
   PlanningContext out{sim, c.bundle, c.index};
   out.end_index = &end_index();
   out.theta = c.theta;
@@ -619,7 +606,7 @@ TEST(LazySp, AGoalBeyondTheBundlesCoverageIsSolvedByTheGrowth) {
   ASSERT_EQ(goal.size(), 7) << "no collision-free state just beyond the bundle's ends";
   ASSERT_GT(nearest_distance(f, goal, true), theta + kTolerance);
   const PlanningContext context = session_context(f, f.sim);
-  const PlanningContext scanning = library_context(f, f.view, f.index);  // no end index
+  const PlanningContext scanning = bundle_context(f.sim, f.view, f.index);  // no end index
   SimulatorWorkspace ws(f.sim);
   PlanningProblem p = library_problem(f.b, goal, 20);
   p.termination.stop_at_first = true;

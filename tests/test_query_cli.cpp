@@ -256,13 +256,7 @@ void expect_same_bundle(const Bundle& a, const Bundle& b) {
                          std::vector<double>{q.theta, q.simulated_seconds}));
   EXPECT_EQ(p.perturbations, q.perturbations);
   EXPECT_EQ(p.seed, q.seed);
-  EXPECT_TRUE(same_array("perturbation.done", p.done, q.done));
-  EXPECT_TRUE(same_array("perturbation.valid", p.valid, q.valid));
-  EXPECT_TRUE(same_array("perturbation.lazy", p.lazy, q.lazy));
-  EXPECT_TRUE(same_array("perturbation.collision", p.collision, q.collision));
-  EXPECT_TRUE(same_array("perturbation.max_error", p.max_error, q.max_error));
-  EXPECT_TRUE(same_array("perturbation.p_lazy_prop", p.p_lazy_prop, q.p_lazy_prop));
-  EXPECT_TRUE(same_array("perturbation.p_collision", p.p_collision, q.p_collision));
+  expect_same_perturbation_arrays(p, q);
 }
 
 // test_planners plans on the library's bundle: it is this one.

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "lazyboe/common/error.h"
+#include "lazyboe/common/text.h"
 #include "lazyboe/planning/registry.h"
 
 namespace lazyboe {
@@ -40,10 +41,7 @@ std::string study_names_text() {
     for (const PlannerVariant& v : info.study_variants)
       if (v.name != info.name) names.push_back(v.name);
   }
-  std::string text;
-  for (size_t k = 0; k < names.size(); ++k)
-    text += (k == 0 ? "" : k + 1 == names.size() ? " or " : ", ") + names[k];
-  return text;
+  return list_text(names);
 }
 
 PlannerSpec spec_named(const std::string& name) {

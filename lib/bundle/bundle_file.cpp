@@ -329,18 +329,8 @@ Bundle read_bundle(const std::string& path) {
     p.max_error = h5::read_dataset<double>(path, file, ds::pert_max_error, {n});
     p.p_lazy_prop = h5::read_dataset<double>(path, file, ds::p_lazy_prop, {n});
     p.p_collision = h5::read_dataset<double>(path, file, ds::p_collision, {n});
-    // The transfer statistics: absent from analyses written before them (all three or none).
-    const bool lazy = h5::exists(file, ds::transfer_lazy);
-    const bool max = h5::exists(file, ds::transfer_max_error);
-    const bool prob = h5::exists(file, ds::p_lazy_prop_transfer);
-    if (lazy || max || prob) {
-      for (const auto& [there, name] :
-           {std::pair{lazy, ds::transfer_lazy}, std::pair{max, ds::transfer_max_error},
-            std::pair{prob, ds::p_lazy_prop_transfer}}) {
-        if (!there)
-          fail(path,
-               std::string(name) + ": dataset missing (the other transfer statistics are present)");
-      }
+    // The transfer statistics: absent from analyses written before them.
+    if (has_transfer_datasets(path, file)) {
       p.has_transfer = true;
       p.transfer_lazy = h5::read_dataset<uint64_t>(path, file, ds::transfer_lazy, {n});
       p.transfer_max_error = h5::read_dataset<double>(path, file, ds::transfer_max_error, {n});
@@ -348,6 +338,21 @@ Bundle read_bundle(const std::string& path) {
     }
   }
   return b;
+}
+
+bool has_transfer_datasets(const std::string& where, hid_t file) {
+  const bool lazy = h5::exists(file, ds::transfer_lazy);
+  const bool max = h5::exists(file, ds::transfer_max_error);
+  const bool prob = h5::exists(file, ds::p_lazy_prop_transfer);
+  if (!(lazy || max || prob)) return false;
+  for (const auto& [there, name] :
+       {std::pair{lazy, ds::transfer_lazy}, std::pair{max, ds::transfer_max_error},
+        std::pair{prob, ds::p_lazy_prop_transfer}}) {
+    if (!there)
+      fail(where,
+           std::string(name) + ": dataset missing (the other transfer statistics are present)");
+  }
+  return true;
 }
 
 DatasetLocation dataset_location(const std::string& where, hid_t file, const std::string& dataset) {

@@ -94,18 +94,8 @@ BundleView BundleView::open(const std::string& path, bool allow_mmap) {
       v.perturbation_theta_ = h5::read_attr_f64(path, g, "theta");
       v.p_lazy_prop_ = v.attach<double>(file, ds::p_lazy_prop, {n}, allow_mmap);
       v.p_collision_ = v.attach<double>(file, ds::p_collision, {n}, allow_mmap);
-      // Optional: absent from analyses written before the transfer statistics; all three or
-      // none, as read_bundle requires.
-      const bool lazy = h5::exists(file, ds::transfer_lazy),
-                 prop = h5::exists(file, ds::p_lazy_prop_transfer),
-                 max_error = h5::exists(file, ds::transfer_max_error);
-      if ((lazy || prop || max_error) && !(lazy && prop && max_error)) {
-        fail(path, std::string(!lazy ? ds::transfer_lazy
-                               : !prop ? ds::p_lazy_prop_transfer
-                                       : ds::transfer_max_error) +
-                       ": dataset missing (the other transfer statistics are present)");
-      }
-      if (lazy) {
+      // Optional: absent from analyses written before the transfer statistics.
+      if (has_transfer_datasets(path, file)) {
         v.p_lazy_prop_transfer_ = v.attach<double>(file, ds::p_lazy_prop_transfer, {n}, allow_mmap);
         v.transfer_max_error_ = v.attach<double>(file, ds::transfer_max_error, {n}, allow_mmap);
         v.has_transfer_ = true;

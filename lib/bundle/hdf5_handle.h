@@ -163,4 +163,9 @@ namespace lazyboe {
 struct DatasetLocation;
 DatasetLocation dataset_location(const std::string& where, hid_t file, const std::string& dataset);
 
+// Whether an open bundle file holds the perturbation's transfer statistics: all three datasets
+// (true) or none (false, an analysis written before them); one of them alone is an Error naming
+// the missing one. read_bundle and BundleView::open both ask this.
+bool has_transfer_datasets(const std::string& where, hid_t file);
+
 }  // namespace lazyboe

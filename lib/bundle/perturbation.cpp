@@ -122,24 +122,24 @@ bool prepare_perturbation(Bundle& b, const PerturbSettings& s, bool replace,
       fail(path, "holds " + std::to_string(p.perturbations) +
                      " perturbations per edge already; use --replace to start over with fewer");
     }
+    const bool complete =
+        std::all_of(p.done.begin(), p.done.end(), [&](uint64_t d) { return d >= s.perturbations; });
     if (p.has_transfer) {
       p.perturbations = s.perturbations;
-      p.complete = std::all_of(p.done.begin(), p.done.end(),
-                               [&](uint64_t d) { return d >= s.perturbations; });
+      p.complete = complete;
       return false;
     }
     // Written before the transfer statistics: kept when there is nothing to add (it still
     // serves the stored lazy model), never redone in place (a checkpoint would replace a
     // complete analysis with an incomplete one).
-    const bool complete = std::all_of(p.done.begin(), p.done.end(),
-                                      [&](uint64_t d) { return d >= s.perturbations; });
     if (complete && s.perturbations == p.perturbations) {
       p.complete = true;
       return true;
     }
-    fail(path, "holds a perturbation analysis written before the transfer statistics, which "
-               "cannot be extended or continued; use --replace to redo it (the file keeps its "
-               "analysis until the new one's first checkpoint)");
+    fail(path,
+         "holds a perturbation analysis written before the transfer statistics, which "
+         "cannot be extended or continued; use --replace to redo it (the file keeps its "
+         "analysis until the new one's first checkpoint)");
   }
   p = Perturbation{};
   p.present = true;

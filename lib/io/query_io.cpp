@@ -41,11 +41,12 @@ double parameter_value(const JsonField& f, const ParameterSpec& spec) {
 // The planner and the values of its declared parameters.
 void parse_planner(const JsonField& root, Query& q) {
   q.planner = root.has("planner") ? root.at("planner").string() : "lazyboe";
-  if (!find_planner(q.planner)) {
+  const PlannerInfo* found = find_planner(q.planner);
+  if (!found) {
     root.at("planner").fail("unknown planner '" + q.planner + "' (expected " +
                             planner_names_text() + ")");
   }
-  const PlannerInfo& info = *find_planner(q.planner);
+  const PlannerInfo& info = *found;
   for (const std::string& name : all_parameter_names()) {
     if (!root.has(name)) continue;
     const JsonField f = root.at(name);
@@ -84,10 +85,14 @@ void parse_goal(const JsonField& goal, const RobotModel& robot, const QueryDefau
   }
 }
 
-std::vector<std::string> query_fields() {
-  std::vector<std::string> fields = {"id",     "start", "goal",         "planner",
-                                     "budget", "seed",  "stop_at_first"};
-  for (const std::string& name : all_parameter_names()) fields.push_back(name);
+// The fields a query may have: its own, and every parameter a registered planner declares.
+const std::vector<std::string>& query_fields() {
+  static const std::vector<std::string> fields = [] {
+    std::vector<std::string> f = {"id",     "start", "goal",         "planner",
+                                  "budget", "seed",  "stop_at_first"};
+    for (const std::string& name : all_parameter_names()) f.push_back(name);
+    return f;
+  }();
   return fields;
 }
 

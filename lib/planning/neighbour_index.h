@@ -13,12 +13,12 @@ namespace lazyboe {
 // Which state of every edge an index holds.
 enum class EdgePoint { Start, End };
 
-class EdgeStartIndex {
+class EdgeIndex {
  public:
-  explicit EdgeStartIndex(const BundleView& bundle, EdgePoint point = EdgePoint::Start);
-  ~EdgeStartIndex();
-  EdgeStartIndex(const EdgeStartIndex&) = delete;
-  EdgeStartIndex& operator=(const EdgeStartIndex&) = delete;
+  explicit EdgeIndex(const BundleView& bundle, EdgePoint point = EdgePoint::Start);
+  ~EdgeIndex();
+  EdgeIndex(const EdgeIndex&) = delete;
+  EdgeIndex& operator=(const EdgeIndex&) = delete;
 
   EdgePoint point() const;
 

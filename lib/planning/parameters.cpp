@@ -3,6 +3,7 @@
 #include <sstream>
 
 #include "lazyboe/common/error.h"
+#include "lazyboe/common/text.h"
 
 namespace lazyboe {
 namespace {
@@ -23,12 +24,7 @@ int ParameterSpec::choice_index(const std::string& key) const {
 
 std::string ParameterSpec::range_text() const {
   if (type == ParameterType::Boolean) return "true or false";
-  if (type == ParameterType::Choice) {
-    std::string text;
-    for (size_t k = 0; k < choices.size(); ++k)
-      text += (k == 0 ? "" : k + 1 == choices.size() ? " or " : ", ") + choices[k];
-    return text;
-  }
+  if (type == ParameterType::Choice) return list_text(choices);
   const bool has_lower = std::isfinite(lower), has_upper = std::isfinite(upper);
   if (has_lower && has_upper) {
     return std::string(lower_exclusive ? "(" : "[") + number_text(lower) + ", " +

@@ -21,16 +21,16 @@ namespace lazyboe {
 // and command family; by default the bundle's); the default neighbourhood radius.
 struct PlanningContext {
   explicit PlanningContext(const Simulator& simulator, const BundleView* edge_bundle = nullptr,
-                           const EdgeStartIndex* edge_index = nullptr)
+                           const EdgeIndex* edge_index = nullptr)
       : sim(simulator), bundle(edge_bundle), index(edge_index) {}
 
   const Simulator& sim;
-  const BundleView* bundle = nullptr;         // null for planners that do not use one
-  const EdgeStartIndex* index = nullptr;      // over the edges' start states
-  const EdgeStartIndex* end_index = nullptr;  // over their end states (goal coverage); optional
-  double theta = 0;                           // the bundle's theta, rad (0: none)
-  JointVector sample_lower, sample_upper;     // state sampling box
-  CommandSampling command;                    // control family of the sampling planners
+  const BundleView* bundle = nullptr;      // null for planners that do not use one
+  const EdgeIndex* index = nullptr;        // over the edges' start states
+  const EdgeIndex* end_index = nullptr;    // over their end states (goal coverage); optional
+  double theta = 0;                        // the bundle's theta, rad (0: none)
+  JointVector sample_lower, sample_upper;  // state sampling box
+  CommandSampling command;                 // control family of the sampling planners
 };
 
 class Planner {

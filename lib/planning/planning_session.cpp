@@ -27,18 +27,24 @@ PlanningSession::PlanningSession(const std::string& bundle_path, bool memory_map
       end_index(bundle, EdgePoint::End),
       load_seconds(std::chrono::duration<double>(Clock::now() - started_).count()) {}
 
-double PlanningSession::default_theta() const {
+double bundle_theta(const BundleView& bundle) {
   return bundle.has_perturbation() ? bundle.perturbation_theta() : bundle.header().design_theta;
 }
 
-PlanningContext PlanningSession::context() const {
+PlanningContext bundle_context(const Simulator& sim, const BundleView& bundle,
+                               const EdgeIndex& index, const EdgeIndex* end_index) {
+  const BuildSettings settings = settings_from_header(bundle.header());
   PlanningContext c{sim, &bundle, &index};
-  c.end_index = &end_index;
-  c.theta = default_theta();
+  c.end_index = end_index;
+  c.theta = bundle_theta(bundle);
   c.sample_lower = settings.region_lower;
   c.sample_upper = settings.region_upper;
   c.command = settings.command;
   return c;
+}
+
+PlanningContext PlanningSession::context() const {
+  return bundle_context(sim, bundle, index, &end_index);
 }
 
 double resident_memory_mib() {

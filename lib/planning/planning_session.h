@@ -17,6 +17,15 @@
 
 namespace lazyboe {
 
+// theta of the bundle's perturbation analysis, or its design theta without one.
+double bundle_theta(const BundleView& bundle);
+
+// The planning context of a bundle, for any holder of one (a session, a test, a front end):
+// the simulator, the bundle and its indexes, and from the bundle's header its theta, sampling
+// box and command family.
+PlanningContext bundle_context(const Simulator& sim, const BundleView& bundle,
+                               const EdgeIndex& index, const EdgeIndex* end_index = nullptr);
+
 class PlanningSession {
  public:
   // Throws Error for a missing or corrupt bundle, or robot/environment files that do not match
@@ -33,17 +42,15 @@ class PlanningSession {
   const BundleView bundle;
   const BundleScene scene;
   const CollisionModel collision;
-  const BuildSettings settings;    // the bundle's simulation, command and region settings
-  const Simulator sim;             // trajectories are not sampled (sample_every = 0)
-  const EdgeStartIndex index;      // edge start states: the planners' neighbourhoods
-  const EdgeStartIndex end_index;  // edge end states: goal coverage
-  const double load_seconds;       // wall time of everything above
+  const BuildSettings settings;  // the bundle's simulation, command and region settings
+  const Simulator sim;           // trajectories are not sampled (sample_every = 0)
+  const EdgeIndex index;         // edge start states: the planners' neighbourhoods
+  const EdgeIndex end_index;     // edge end states: goal coverage
+  const double load_seconds;     // wall time of everything above
 
-  // The planning context: the simulator, the bundle and its index, and from the bundle the
-  // default theta (default_theta), the sampling box and the command family.
+  // bundle_context of the session's simulator, bundle and indexes.
   PlanningContext context() const;
-  // theta of the perturbation analysis, or the bundle's design theta without one.
-  double default_theta() const;
+  double default_theta() const { return bundle_theta(bundle); }
 };
 
 // Resident memory of this process (VmRSS), MiB; 0 where /proc is not available.

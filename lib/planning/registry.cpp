@@ -4,6 +4,7 @@
 #include <sstream>
 
 #include "lazyboe/common/error.h"
+#include "lazyboe/common/text.h"
 #include "lazyboe/planning/ompl/ompl_planners.h"
 #include "lazyboe/planning/planners/boe.h"
 #include "lazyboe/planning/planners/lazyboe.h"
@@ -50,22 +51,21 @@ const PlannerInfo& planner_info(const std::string& name, const std::string& wher
 }
 
 std::string planner_names_text() {
-  const std::vector<PlannerInfo>& all = planner_registry();
-  std::string text;
-  for (size_t k = 0; k < all.size(); ++k) {
-    if (k > 0) text += k + 1 == all.size() ? " or " : ", ";
-    text += all[k].name;
-  }
-  return text;
+  std::vector<std::string> names;
+  for (const PlannerInfo& info : planner_registry()) names.push_back(info.name);
+  return list_text(names);
 }
 
-std::vector<std::string> all_parameter_names() {
-  std::vector<std::string> names;
-  for (const PlannerInfo& info : planner_registry()) {
-    for (const ParameterSpec& p : info.parameters) {
-      if (std::find(names.begin(), names.end(), p.name) == names.end()) names.push_back(p.name);
+const std::vector<std::string>& all_parameter_names() {
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> out;
+    for (const PlannerInfo& info : planner_registry()) {
+      for (const ParameterSpec& p : info.parameters) {
+        if (std::find(out.begin(), out.end(), p.name) == out.end()) out.push_back(p.name);
+      }
     }
-  }
+    return out;
+  }();
   return names;
 }
 
@@ -93,9 +93,7 @@ std::string needs_text(const PlannerInfo& info) {
   if (info.needs.perturbation) needs.push_back("its perturbation analysis");
   if (info.needs.ompl) needs.push_back("OMPL");
   if (needs.empty()) return "a simulator (the bundle's sampling region and commands)";
-  std::string text;
-  for (size_t k = 0; k < needs.size(); ++k) text += (k == 0 ? "" : ", ") + needs[k];
-  return text;
+  return list_text(needs, ", ");
 }
 
 const char* type_name(ParameterType t) {

@@ -54,7 +54,7 @@ const PlannerInfo& planner_info(const std::string& name, const std::string& wher
 std::string planner_names_text();
 
 // Every parameter name any planner declares, each once.
-std::vector<std::string> all_parameter_names();
+const std::vector<std::string>& all_parameter_names();
 
 // A planner with `values` checked against its declarations (Error("<name>: must be > 0") for
 // a value out of range, Error("<planner>: no parameter 'x'") for one it does not declare) and

@@ -34,7 +34,7 @@ double bundle_planner_setup(const PlanningContext& ctx, const ParameterValues& v
 
 bool edge_ends_near(const PlanningContext& ctx, const JointVectorRef& q, double radius,
                     std::vector<std::pair<uint32_t, double>>& scratch) {
-  if (ctx.end_index && ctx.end_index->point() == EdgePoint::End) {
+  if (ctx.end_index) {
     ctx.end_index->within(q.data(), radius, scratch);
     return !scratch.empty();
   }

@@ -44,9 +44,19 @@ using Neighbours = std::vector<std::pair<uint32_t, double>>;
 
 class LazySpSearch {
  public:
+  // The constructor BundlePlanner calls (the pool is not used: one thread).
   LazySpSearch(const PlanningContext& ctx, SimulatorWorkspace& ws, const PlanningProblem& p,
-               const Settings& settings)
-      : ctx_(ctx), bundle_(*ctx.bundle), s_(ctx, ws, p), set_(settings), rng_(p.seed, kStream) {}
+               double theta, RolloutPool*, const ParameterValues& values)
+      : ctx_(ctx),
+        bundle_(*ctx.bundle),
+        s_(ctx, ws, p),
+        set_(settings_of(theta, values)),
+        rng_(p.seed, kStream) {}
+
+  // Beyond a bundle, the growth needs a sampling box.
+  static void check_context(const PlanningContext& ctx, const ParameterValues&) {
+    check_sampling_box(ctx, "lazysp");
+  }
 
   PlanResult run();
 
@@ -68,6 +78,14 @@ class LazySpSearch {
     return bundle_.has_perturbation() ? set_.risk_weight * bundle_.p_collision(e) : 0.0;
   }
   static uint64_t key(int v, uint32_t e) { return (static_cast<uint64_t>(v) << 32) | e; }
+  static Settings settings_of(double theta, const ParameterValues& v) {
+    return {theta,
+            v.get("epsilon"),
+            v.get("resolution"),
+            v.get("risk_weight"),
+            v.get("goal_bias"),
+            static_cast<size_t>(v.get("expansion_limit"))};
+  }
 
   const PlanningContext& ctx_;
   const BundleView& bundle_;
@@ -307,32 +325,6 @@ uint64_t LazySpSearch::cell(const JointVector& q) const {
   return h;
 }
 
-class LazySpPlanner : public Planner {
- public:
-  explicit LazySpPlanner(const ParameterValues& values) : values_(values) {}
-
-  void setup(const PlanningContext& context) override {
-    settings_.theta = bundle_planner_setup(context, values_, "lazysp", false);
-    check_sampling_box(context, "lazysp");
-    settings_.epsilon = values_.get("epsilon");
-    settings_.resolution = values_.get("resolution");
-    settings_.risk_weight = values_.get("risk_weight");
-    settings_.goal_bias = values_.get("goal_bias");
-    settings_.expansion_limit = static_cast<size_t>(values_.get("expansion_limit"));
-    context_ = &context;
-  }
-
-  PlanResult solve(const PlanningProblem& problem, SimulatorWorkspace& ws, RolloutPool*) override {
-    if (!context_) fail("lazysp", "solve before setup");
-    return LazySpSearch(*context_, ws, problem, settings_).run();
-  }
-
- private:
-  ParameterValues values_;
-  Settings settings_;
-  const PlanningContext* context_ = nullptr;
-};
-
 }  // namespace
 
 PlannerInfo lazysp_planner_info() {
@@ -359,7 +351,9 @@ PlannerInfo lazysp_planner_info() {
       goal_bias_parameter(),
       limit,
   };
-  info.make = [](const ParameterValues& v) { return std::make_unique<LazySpPlanner>(v); };
+  info.make = [](const ParameterValues& v) {
+    return std::make_unique<BundlePlanner<LazySpSearch>>(v, "lazysp", false);
+  };
   return info;
 }
 
