@@ -58,10 +58,11 @@ namespace {
 using Vec = Eigen::Map<const Eigen::VectorXd>;
 
 // One pass over the samples in time order. Per sample k: collision of the motion that led to
-// it (the simulator's margin rule), then its position, velocity and rest, then the control
-// period k -> k+1 (velocity from positions, acceleration, torque) and the jerk and torque rate
-// at k (from period k-1; before the first sample and after the last the robot holds still at
-// g(q)). Every estimate is compared with its limit plus its rounding allowance.
+// it (the simulator's margin rule: configurations before t_k), then its position, velocity and
+// rest, then the control period k -> k+1 (velocity from positions, acceleration, torque) and the
+// jerk and torque rate at k (from period k-1; before the first sample and after the last the
+// robot holds still at g(q)), then (first sample) its collision. Every estimate is compared with
+// its limit plus its rounding allowance.
 class Scan {
  public:
   Scan(const TrajectoryChecker& checker, TrajectoryCheckWorkspace& ws, const TrajectoryView& traj)
@@ -81,11 +82,11 @@ class Scan {
 
   void run() {
     const int last = traj_.samples - 1;
-    if (o_.check_collision && collides_at(0, 0.0, q(0))) return;
     for (int k = 0; k <= last; ++k) {
       if (k > 0 && o_.check_collision && motion_collides(k)) return;
       if (sample_violates(k)) return;
       if (period_violates(k)) return;
+      if (k == 0 && o_.check_collision && collides_at(0, 0.0, q(0))) return;
     }
     if (o_.check_collision && moved_ > 0 && collides_at(last, 0.0, q(last))) return;
   }
