@@ -59,14 +59,12 @@ int exact_sample_every_ticks(double interval_s, double control_rate, const std::
   return ticks;
 }
 
-namespace {
-
 // r_i: a point of a shape on body b >= i is at most
 //   sum_{k=i+1..b} |origin of joint k in body k-1| + |shape origin in body b| + shape radius
 // from joint i's origin, so turning joint i by dq moves it at most r_i |dq| (a prismatic
 // joint moves everything by exactly |dq|). Summed over joints, this bounds the path length of
 // every point of the robot for a small joint motion.
-JointVector lever_arms(const RobotModel& robot, const CollisionModel& collision) {
+JointVector collision_lever_arms(const RobotModel& robot, const CollisionModel& collision) {
   const int n = robot.dof;
   JointVector r = JointVector::Zero(n);
   for (int i = 0; i < n; ++i) {
@@ -84,6 +82,8 @@ JointVector lever_arms(const RobotModel& robot, const CollisionModel& collision)
   return r;
 }
 
+namespace {
+
 bool within(const JointVector& value, const JointVector& bound) {
   return (value.array().abs() <= bound.array()).all();
 }
@@ -96,7 +96,7 @@ Simulator::Simulator(const RobotModel& robot_model, const CollisionModel& collis
       collision(collision_model),
       options(opts),
       dt(1.0 / robot_model.control_rate),
-      lever_arm(lever_arms(robot_model, collision_model)) {
+      lever_arm(collision_lever_arms(robot_model, collision_model)) {
   if (!robot.controller.present) {
     fail(robot.config_path, "controller: missing (the simulator needs the joint controller gains)");
   }

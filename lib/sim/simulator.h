@@ -60,6 +60,11 @@ double sample_interval_seconds(int ticks, double control_rate);
 // throws Error("<where>: must be a multiple of the control period (<period> s)") otherwise.
 int exact_sample_every_ticks(double interval_s, double control_rate, const std::string& where);
 
+// Per joint: a bound on the motion of any point of the robot's collision shapes per unit
+// motion of that joint, so that lever_arm . |q1 - q0| bounds every point's path for a small
+// joint motion (the collision-check spacing rule).
+JointVector collision_lever_arms(const RobotModel& robot, const CollisionModel& collision);
+
 struct Simulator {
   Simulator(const RobotModel& robot, const CollisionModel& collision, SimulationOptions options);
 
