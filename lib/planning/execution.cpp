@@ -12,8 +12,6 @@ namespace {
 // Peak |s'| and |s''| of the minimum-jerk blend on [0, 1] (command_profile.cpp).
 constexpr double kPeakSlope = 1.875;
 constexpr double kPeakCurvature = 5.773502691896258;
-// Shortened junction intervals tried, as fractions of the original ones (smallest first).
-constexpr double kBlendScales[] = {0.5, 0.6, 0.7, 0.8, 0.9};
 
 // A step of the path being processed: its command with knot times, and the raw chain's state
 // it should end at.
@@ -203,9 +201,10 @@ std::vector<Step> shortcut_steps(Work& w, const RawChain& raw, std::vector<Step>
 
 // The smallest shortened junction (fraction of its two intervals) whose blend stays within the
 // commanded limits, or 0 when none does. a, b: the knots before and after the junction's zero.
-double blend_scale(const RobotModel& robot, const CommandSampling& limits, const double* a,
+double blend_scale(const RobotModel& robot, const ExecutionOptions& options, const double* a,
                    const double* b, double h1, double h2) {
-  for (double alpha : kBlendScales) {
+  const CommandSampling& limits = options.limits;
+  for (double alpha : options.blend_scales) {
     bool ok = true;
     for (int i = 0; i < robot.dof && ok; ++i) {
       const double v = (1 - alpha) / alpha * (h1 * a[i] + h2 * b[i]) / (h1 + h2);
@@ -314,7 +313,7 @@ std::vector<double> junction_scales(const Work& w, const std::vector<Step>& step
     const Step& next = steps[s + 1];
     const int count = static_cast<int>(st.times.size());
     scale.push_back(w.options.blend
-                        ? blend_scale(w.sim.robot, w.options.limits, &st.knots[(count - 2) * n],
+                        ? blend_scale(w.sim.robot, w.options, &st.knots[(count - 2) * n],
                                       &next.knots[n], st.times[count - 1] - st.times[count - 2],
                                       next.times[1] - next.times[0])
                         : 0.0);
@@ -342,7 +341,7 @@ bool blend_segments(Work& w, const std::vector<Step>& steps, const RawChain& raw
       const Attempt at = try_segment(w, steps, raw, a, b, scale, q0, goal, seg);
       if (at.ok) break;
       if (at.junction < 0) return false;
-      const double longest = kBlendScales[std::size(kBlendScales) - 1];
+      const double longest = w.options.blend_scales.back();
       if (!retried[at.junction] && scale[at.junction] < longest) {
         retried[at.junction] = true;
         scale[at.junction] = longest;
