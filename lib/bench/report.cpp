@@ -304,8 +304,8 @@ void write_execution(std::ostream& md, std::map<std::string, PlannerStats>& stat
   md << "Over the successful runs: the returned trajectory (post-processed: shortcuts and "
         "junction blending, docs/execution.md; the raw chain itself with --raw) against the "
         "raw edge chain. Stops exclude the start and the end. Post-processing runs after the "
-        "planner's clock has stopped, outside the budget; its time includes re-simulating the "
-        "raw chain.\n\n";
+        "planner's clock has stopped, outside the budget; its time is what it adds to the raw "
+        "chain's re-simulation, which every run has.\n\n";
   md << "| planner | median duration (s) | median raw duration (s) | shorter | median stops | "
         "median raw stops | median arc length (rad) | median raw arc length (rad) | blends kept "
         "| shortcuts | median post-processing (s) | median TTFS + post-processing (s) |\n";

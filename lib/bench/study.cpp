@@ -108,10 +108,15 @@ void record_execution(const PlanningContext& context, SimulatorWorkspace& ws,
   o.limits = context.command;
   const ExecutableTrajectory e =
       make_executable(context.sim, ws, p.start, result.best_path, p.goal, o, 1000);
+  // The raw chain's figures come from the stage's own re-simulation of it (the same
+  // simulations as realize_path's, so the same cost to the last bit).
+  r.best_cost = e.stats.raw_cost;
+  r.raw_duration = e.stats.raw_duration;
+  r.raw_stops = e.stats.raw_stops;
   r.duration = e.trajectory.duration;
   r.stops = e.trajectory.stops;
   r.arc_length = e.trajectory.cost;
-  r.post_seconds = e.stats.seconds;
+  r.post_seconds = e.stats.seconds - e.stats.raw_seconds;
   r.junctions = e.stats.junctions;
   r.blends_kept = e.stats.blends_kept;
   r.shortcuts = e.stats.shortcuts;
@@ -146,21 +151,21 @@ RunRecord run_planner(const PlanningContext& context, SimulatorWorkspace& ws,
       r.failure = result.failure;
       return r;
     }
-    const Trajectory t = [&] {
-      try {
-        return realize_path(context.sim, ws, p.start, result.best_path, p.goal, 1000);
-      } catch (const Error&) {
-        r.n_solutions = 0;  // the path failed the re-check: it is not a solution
-        throw;
+    try {
+      if (execution) {
+        record_execution(context, ws, p, result, *execution, r);
+      } else {
+        const Trajectory t = realize_path(context.sim, ws, p.start, result.best_path, p.goal, 1000);
+        r.best_cost = r.arc_length = t.cost;
+        r.raw_duration = r.duration = t.duration;
+        r.raw_stops = r.stops = t.stops;
       }
-    }();
+    } catch (const Error&) {
+      r.n_solutions = 0;  // the path failed the re-check: it is not a solution
+      throw;
+    }
     r.success = true;
     r.time_to_first_solution = result.time_to_first_solution;
-    r.best_cost = t.cost;
-    r.raw_duration = r.duration = t.duration;
-    r.raw_stops = r.stops = t.stops;
-    r.arc_length = t.cost;
-    if (execution) record_execution(context, ws, p, result, *execution, r);
   } catch (const std::exception& e) {  // nothing may leave a run (an OpenMP region)
     r.success = false;
     r.failure = std::string("error: ") + e.what();

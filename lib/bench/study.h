@@ -53,7 +53,9 @@ struct RunRecord {
   double arc_length = std::numeric_limits<double>::quiet_NaN();  // rad
   double raw_duration = std::numeric_limits<double>::quiet_NaN();
   int raw_stops = -1;
-  double post_seconds = 0;  // wall time of the post-processing (not part of the budget)
+  // Wall time the post-processing adds (beyond the raw chain's re-simulation, which every run
+  // has); not part of the budget.
+  double post_seconds = 0;
   int junctions = -1, blends_kept = -1, shortcuts = -1;
 };
 
@@ -61,10 +63,11 @@ struct RunRecord {
 uint64_t run_seed(uint64_t study_seed, int problem, int repeat);
 
 // One run. The best path is re-simulated from the exact start with every check
-// (realize_path); its cost is the reported cost (the planner's path, as the paper reports it),
-// and a path that fails the check is reported as a failed run with the reason (it would be a
-// planner bug). With `execution`, the path is then post-processed (make_executable, after the
-// planner's clock has stopped) and the record gets the executed trajectory's figures.
+// (realize_path, or make_executable's raw pass); its cost is the reported cost (the planner's
+// path, as the paper reports it), and a path that fails the check is reported as a failed run
+// with the reason (it would be a planner bug). With `execution`, the path is also post-processed
+// (make_executable, after the planner's clock has stopped) and the record gets the executed
+// trajectory's figures.
 RunRecord run_planner(const PlanningContext& context, SimulatorWorkspace& ws,
                       const PlannerSpec& planner, const BenchProblem& problem, int problem_index,
                       int repeat, uint64_t seed, double budget,

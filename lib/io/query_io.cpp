@@ -140,7 +140,8 @@ nlohmann::json execution_json(const ExecutionStats& e) {
   return {{"raw_steps", e.raw_steps},     {"steps", e.steps},
           {"shortcuts", e.shortcuts},     {"junctions", e.junctions},
           {"blends_kept", e.blends_kept}, {"simulations", e.simulations},
-          {"seconds", e.seconds},         {"fell_back", e.fell_back}};
+          {"seconds", e.seconds},         {"raw_seconds", e.raw_seconds},
+          {"fell_back", e.fell_back}};
 }
 
 }  // namespace

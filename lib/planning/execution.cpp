@@ -400,6 +400,8 @@ ExecutableTrajectory make_executable(const Simulator& sim, SimulatorWorkspace& w
   ExecutionStats& st = out.stats;
   Work w{sim, ws, options, st, {}};
   const RawChain raw = simulate_raw(w, start, steps, goal);
+  st.raw_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - clock_start).count();
   st.raw_steps = static_cast<int>(steps.size());
   st.raw_duration = raw.duration;
   for (double c : raw.cost) st.raw_cost += c;

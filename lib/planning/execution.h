@@ -63,6 +63,7 @@ struct ExecutionStats {
   int stops = 0;           // junctions kept at rest (= junctions - blends_kept)
   int simulations = 0;     // rollouts simulated by this stage (the raw chain's included)
   double seconds = 0;      // wall time of this stage (reported, never used in a decision)
+  double raw_seconds = 0;  // of which re-simulating the raw chain (realize_path's work)
   bool fell_back = false;  // the raw chain is returned as it is
   double raw_duration = 0, raw_cost = 0;
   int raw_stops = 0;
