@@ -144,7 +144,10 @@ ToolRun run_batch(const std::string& name, const std::vector<json>& queries,
 // A result without the fields that depend on the wall clock.
 json timeless(json r) {
   r.erase("time_to_first_solution");
-  if (r.contains("post_processing")) r["post_processing"].erase("seconds");
+  if (r.contains("post_processing")) {
+    r["post_processing"].erase("seconds");
+    r["post_processing"].erase("raw_seconds");
+  }
   return r;
 }
 
@@ -915,6 +918,25 @@ TEST(QueryCli, RawGivesThePlannersEdgeChainsAndPostProcessingIsShorter) {
     EXPECT_EQ(resimulate(f, start, bundle_commands(f, traj.edges), traj), "");
   }
   EXPECT_GT(shorter, 0) << "post-processing never shortened a trajectory";
+}
+
+// Result lines, post-processed and raw, follow schemas/result.schema.json (validated by
+// tests/validate_schemas.py with python3-jsonschema).
+TEST(QueryCli, ResultLinesFollowTheResultSchema) {
+  const ToolRun& post = deterministic_run();
+  expect_batch_ran(post, deterministic_queries().size());
+  std::vector<json> quick = quick_queries();
+  quick.resize(2);
+  const ToolRun raw = run_batch("quick", quick, {"--trajectories", "inline", "--quiet", "--raw"});
+  expect_batch_ran(raw, quick.size());
+  std::string lines;
+  for (const ToolRun* t : {&post, &raw})
+    for (const json& r : t->results) lines += r.dump() + "\n";
+  const std::string file = write_temp_file("results.jsonl", lines);
+  const CommandResult r = run(
+      "/usr/bin/python3 " + quote(std::string(LAZYBOE_SOURCE_DIR) + "/tests/validate_schemas.py") +
+      " " + quote(LAZYBOE_SOURCE_DIR) + " " + quote(file));
+  EXPECT_EQ(r.exit_code, 0) << describe(r);
 }
 
 // --control-rate: one sample per control tick (1 ms), from the exact start at rest to rest

@@ -12,6 +12,8 @@ namespace {
 // Peak |s'| and |s''| of the minimum-jerk blend on [0, 1] (command_profile.cpp).
 constexpr double kPeakSlope = 1.875;
 constexpr double kPeakCurvature = 5.773502691896258;
+// Fraction of the command limits a direct command between two steps uses.
+constexpr double kJunctionRoom = 0.7;
 
 // A step of the path being processed: its command with knot times, and the raw chain's state
 // it should end at.
@@ -20,6 +22,11 @@ struct Step {
   JointVector target;
   int first_raw = 0, last_raw = 0;  // the raw steps it stands for
   bool uniform = false;             // evenly spaced knots (a raw step's)
+  // A shortcut's accepted simulation from the raw chain's state (the blend pass reuses it for a
+  // segment of this step alone from that same state).
+  bool simulated = false;
+  RolloutResult result;
+  std::vector<double> ticks;
 };
 
 // The raw chain: each step simulated from the previous end, as realize_path does.
@@ -170,8 +177,11 @@ std::vector<Step> shortcut_steps(Work& w, const RawChain& raw, std::vector<Step>
       for (int k = i; k <= j; ++k) run_cost += raw.cost[k];
       const JointVector& from = raw.states[i];
       const JointVector& to = raw.states[j + 1];
-      if (!direct_command(w.sim.robot, w.options.limits, to - from, w.sim.dt, direct.times,
-                          direct.knots))
+      // A direct command with a neighbouring step keeps room in its acceleration and jerk for
+      // the blends at its junctions (at the limits, no blend of it would fit them).
+      CommandSampling limits = w.options.limits;
+      if (i > 0 || j + 1 < m) limits.limit_scale *= kJunctionRoom;
+      if (!direct_command(w.sim.robot, limits, to - from, w.sim.dt, direct.times, direct.knots))
         continue;
       ++attempts;
       const int last = static_cast<int>(direct.times.size()) - 1;
@@ -180,6 +190,7 @@ std::vector<Step> shortcut_steps(Work& w, const RawChain& raw, std::vector<Step>
       const bool lands = r.valid() && (r.qf - to).norm() <= w.options.end_tolerance &&
                          (j + 1 < m || goal.contains(w.sim.robot, w.ws.robot, r.qf));
       if (lands && r.path_length < run_cost) {
+        direct.result = r;
         accepted = j;
         break;
       }
@@ -189,6 +200,8 @@ std::vector<Step> shortcut_steps(Work& w, const RawChain& raw, std::vector<Step>
       ++i;
       continue;
     }
+    direct.simulated = true;
+    direct.ticks = w.ticks;  // of the accepted simulation, the last one made
     direct.target = raw.states[accepted + 1];
     direct.first_raw = i;
     direct.last_raw = accepted;
@@ -272,9 +285,14 @@ Attempt try_segment(Work& w, const std::vector<Step>& steps, const RawChain& raw
   Joined j = join_steps(steps, a, b, scale, n);
   const JointVector offset = q0 - raw.states[steps[a].first_raw];
   const bool uniform = a == b && steps[a].uniform;
-  const RolloutResult r =
-      simulate_to_target(w, q0, j.times, j.knots, j.last_step_first_knot,
-                         static_cast<int>(j.times.size()) - 1, steps[b].target, offset, uniform);
+  RolloutResult r;
+  if (a == b && steps[a].simulated && offset.cwiseAbs().maxCoeff() == 0) {
+    r = steps[a].result;  // this very command from this very state: simulated already
+    w.ticks = steps[a].ticks;
+  } else {
+    r = simulate_to_target(w, q0, j.times, j.knots, j.last_step_first_knot,
+                           static_cast<int>(j.times.size()) - 1, steps[b].target, offset, uniform);
+  }
   const bool last = b + 1 == static_cast<int>(steps.size());
   const bool lands = r.valid() && (r.qf - steps[b].target).norm() <= w.options.end_tolerance &&
                      (!last || goal.contains(w.sim.robot, w.ws.robot, r.qf));
