@@ -85,8 +85,7 @@ Trajectory realize_path(const Simulator& sim, SimulatorWorkspace& ws, const Join
     const size_t rows = sq.size() / n;
     for (size_t i = (k == 0 ? 0 : 1); i < rows; ++i) {  // a step starts where the last ended
       const bool last = i + 1 == rows;
-      traj.t.push_back(t0 +
-                       (last ? r.duration : static_cast<double>(i * sample_every) * sim.dt));
+      traj.t.push_back(t0 + (last ? r.duration : static_cast<double>(i * sample_every) * sim.dt));
       // The start and each step's end are exact; samples in between are stored as float32
       // by the simulator (to about 1e-7 rad).
       JointVector qi(n), dqi(n);
@@ -103,6 +102,7 @@ Trajectory realize_path(const Simulator& sim, SimulatorWorkspace& ws, const Join
     q = r.qf;
   }
   traj.duration = t0;
+  traj.stops = static_cast<int>(steps.size()) - 1;
   if (steps.empty() || !goal.contains(sim.robot, ws.robot, q)) {
     fail("path", "does not end inside the goal region");
   }

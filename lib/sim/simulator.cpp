@@ -131,6 +131,15 @@ RolloutStatus collision_status(const Simulator& sim, SimulatorWorkspace& ws, con
   return report.env_collision ? RolloutStatus::EnvCollision : RolloutStatus::SelfCollision;
 }
 
+// One row of TrajectorySamples::ticks; its acceleration is filled in once known.
+void push_tick(std::vector<double>& ticks, const JointVector& q, const JointVector& dq,
+               const JointVector& ddq, const JointVector& v_cmd) {
+  ticks.insert(ticks.end(), q.data(), q.data() + q.size());
+  ticks.insert(ticks.end(), dq.data(), dq.data() + dq.size());
+  ticks.insert(ticks.end(), ddq.data(), ddq.data() + ddq.size());
+  ticks.insert(ticks.end(), v_cmd.data(), v_cmd.data() + v_cmd.size());
+}
+
 void push_sample(const TrajectorySamples& samples, const JointVector& q, const JointVector& dq) {
   if (!samples.q) return;
   for (int i = 0; i < q.size(); ++i) {
@@ -275,12 +284,15 @@ RolloutResult simulate(const Simulator& sim, SimulatorWorkspace& ws, const Joint
         if (samples.q && (sample_every <= 0 || tick % sample_every != 0)) {
           push_sample(samples, q, dq);
         }
+        if (samples.ticks) push_tick(*samples.ticks, q, dq, ddq_prev, v_cmd);
         return finish(RolloutStatus::Valid, tick);
       }
     }
 
+    if (samples.ticks) push_tick(*samples.ticks, q, dq, ddq_prev, v_cmd);
     q_prev = q;
     integrate_period(sim, rd, tau, h, q, dq, ddq, k);
+    if (samples.ticks) std::copy(ddq.data(), ddq.data() + n, samples.ticks->end() - 2 * n);
     if (!within(ddq, robot.ddq_max)) return finish(RolloutStatus::AccelerationLimit, tick);
     if (!within(ddq - ddq_prev, ddq_step_max)) return finish(RolloutStatus::JerkLimit, tick);
     ddq_prev = ddq;

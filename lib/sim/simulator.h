@@ -92,11 +92,15 @@ struct RolloutResult {
 };
 
 // Optional output of a rollout: states every `every` control ticks (0: the simulator's
-// options.sample_every), plus the final state.
+// options.sample_every), plus the final state. `ticks`, when given, gets every control tick
+// in double precision, one row of 4 dof values per tick from the start (tick 0) to the final
+// state: q, dq, ddq (the acceleration over the tick that follows; over the last tick for the
+// final state) and the commanded joint velocity.
 struct TrajectorySamples {
   std::vector<float>* q = nullptr;
   std::vector<float>* dq = nullptr;
   int every = 0;
+  std::vector<double>* ticks = nullptr;
 };
 
 // Simulates from rest at q0. Stops at the first violation. Allocates nothing when the sample
