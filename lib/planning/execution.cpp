@@ -37,7 +37,8 @@ struct RawChain {
 };
 
 struct Work {
-  const Simulator& sim;
+  const Simulator& sim;        // segments that end at a stop: execution_simulator
+  const Simulator& final_sim;  // the last segment, after which the arm holds: the planners'
   SimulatorWorkspace& ws;
   const ExecutionOptions& options;
   ExecutionStats& stats;
@@ -109,7 +110,8 @@ void correct_command(std::vector<double>& times, std::vector<double>& knots, int
 RolloutResult simulate_to_target(Work& w, const JointVectorRef& q0, std::vector<double>& times,
                                  std::vector<double>& knots, int first, int last,
                                  const JointVector& target, const JointVector& predicted_offset,
-                                 bool uniform = false) {
+                                 bool ends_trajectory, bool uniform = false) {
+  const Simulator& sim = ends_trajectory ? w.final_sim : w.sim;
   const int n = w.sim.robot.dof;
   if (predicted_offset.cwiseAbs().maxCoeff() > 0)
     correct_command(times, knots, first, last, -predicted_offset);
@@ -118,7 +120,7 @@ RolloutResult simulate_to_target(Work& w, const JointVectorRef& q0, std::vector<
     w.ticks.clear();
     const CommandProfile p{knots.data(), static_cast<int>(times.size()), n, times.back(),
                            uniform ? nullptr : times.data()};
-    r = simulate(w.sim, w.ws, q0, p, {nullptr, nullptr, 0, &w.ticks});
+    r = simulate(sim, w.ws, q0, p, {nullptr, nullptr, 0, &w.ticks});
     ++w.stats.simulations;
     if (!r.valid() || round >= w.options.max_corrections) return r;
     const JointVector residual = target - r.qf;
@@ -128,6 +130,12 @@ RolloutResult simulate_to_target(Work& w, const JointVectorRef& q0, std::vector<
 }
 
 }  // namespace
+
+Simulator execution_simulator(const Simulator& sim) {
+  Simulator stopping = sim;
+  stopping.options.settle_for_stop = true;
+  return stopping;
+}
 
 bool direct_command(const RobotModel& robot, const CommandSampling& limits,
                     const JointVectorRef& displacement, double dt, std::vector<double>& times,
@@ -186,7 +194,7 @@ std::vector<Step> shortcut_steps(Work& w, const RawChain& raw, std::vector<Step>
       ++attempts;
       const int last = static_cast<int>(direct.times.size()) - 1;
       const RolloutResult r = simulate_to_target(w, from, direct.times, direct.knots, 1, last, to,
-                                                 JointVector::Zero(to.size()));
+                                                 JointVector::Zero(to.size()), j + 1 == m);
       const bool lands = r.valid() && (r.qf - to).norm() <= w.options.end_tolerance &&
                          (j + 1 < m || goal.contains(w.sim.robot, w.ws.robot, r.qf));
       if (lands && r.path_length < run_cost) {
@@ -285,15 +293,16 @@ Attempt try_segment(Work& w, const std::vector<Step>& steps, const RawChain& raw
   Joined j = join_steps(steps, a, b, scale, n);
   const JointVector offset = q0 - raw.states[steps[a].first_raw];
   const bool uniform = a == b && steps[a].uniform;
+  const bool last = b + 1 == static_cast<int>(steps.size());
   RolloutResult r;
   if (a == b && steps[a].simulated && offset.cwiseAbs().maxCoeff() == 0) {
-    r = steps[a].result;  // this very command from this very state: simulated already
+    r = steps[a].result;  // this very command from this very state (and settle): simulated
     w.ticks = steps[a].ticks;
   } else {
     r = simulate_to_target(w, q0, j.times, j.knots, j.last_step_first_knot,
-                           static_cast<int>(j.times.size()) - 1, steps[b].target, offset, uniform);
+                           static_cast<int>(j.times.size()) - 1, steps[b].target, offset, last,
+                           uniform);
   }
-  const bool last = b + 1 == static_cast<int>(steps.size());
   const bool lands = r.valid() && (r.qf - steps[b].target).norm() <= w.options.end_tolerance &&
                      (!last || goal.contains(w.sim.robot, w.ws.robot, r.qf));
   Attempt at;
@@ -416,8 +425,10 @@ ExecutableTrajectory make_executable(const Simulator& sim, SimulatorWorkspace& w
   const auto clock_start = std::chrono::steady_clock::now();
   ExecutableTrajectory out;
   ExecutionStats& st = out.stats;
-  Work w{sim, ws, options, st, {}};
-  const RawChain raw = simulate_raw(w, start, steps, goal);
+  Work raw_work{sim, sim, ws, options, st, {}};
+  const RawChain raw = simulate_raw(raw_work, start, steps, goal);
+  const Simulator stopping = execution_simulator(sim);
+  Work w{stopping, sim, ws, options, st, {}};
   st.raw_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - clock_start).count();
   st.raw_steps = static_cast<int>(steps.size());
@@ -442,7 +453,7 @@ ExecutableTrajectory make_executable(const Simulator& sim, SimulatorWorkspace& w
     std::vector<Step> plain = raw_steps(steps, raw, sim.robot.dof);
     ExecutionOptions stop_all = options;
     stop_all.blend = false;
-    Work again{sim, ws, stop_all, st, {}};
+    Work again{stopping, sim, ws, stop_all, st, {}};
     rows.clear();
     segment_rows.clear();
     if (!blend_segments(again, plain, raw, start, goal, out.segments, rows, segment_rows))

@@ -84,6 +84,12 @@ ExecutableTrajectory make_executable(const Simulator& sim, SimulatorWorkspace& w
                                      const std::vector<PathStep>& steps, const Goal& goal,
                                      const ExecutionOptions& options, int sample_every);
 
+// The simulator of the returned segments that end at a kept stop: `sim` with settle_for_stop,
+// since the next segment starts from exactly zero velocity, so the arm must be able to stop
+// dead there. The last segment, after which the arm holds its position under the controller,
+// and the raw chain keep `sim`'s settle, as the planners simulated them.
+Simulator execution_simulator(const Simulator& sim);
+
 // A joint-space straight line from rest by `displacement` to rest, as fast as `limits` allow the
 // commanded velocity, acceleration and jerk (N intervals: knots 0, v, ..., v, 0); false when
 // the displacement is (numerically) zero.

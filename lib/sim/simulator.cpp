@@ -217,6 +217,15 @@ struct Stages {
   return RolloutStatus::Valid;
 }
 
+// Stopping dead within one tick from dq takes the acceleration a = -dq / dt, a jerk of
+// (a - ddq_prev) / dt and a torque change of about M(q) (a - ddq_prev) (rd.M: this tick's).
+bool can_stop_dead(const RobotModel& robot, const RobotData& rd, const JointVector& dq,
+                   const JointVector& ddq_prev, double dt) {
+  const JointVector jump = -dq / dt - ddq_prev;
+  if (!within(dq / dt, robot.ddq_max) || !within(jump, robot.dddq_max * dt)) return false;
+  return within(rd.M * jump, 0.5 * robot.dtau_max * dt);
+}
+
 }  // namespace
 
 RolloutResult simulate(const Simulator& sim, SimulatorWorkspace& ws, const JointVectorRef& q0_in,
@@ -276,7 +285,8 @@ RolloutResult simulate(const Simulator& sim, SimulatorWorkspace& ws, const Joint
     // At rest after the command: stop once the next edge could start without a jump in
     // velocity, acceleration (jerk) or torque (the next edge starts from holding torque g(q)).
     if (t >= profile.duration && (dq.array().abs() <= sim.options.settle_velocity).all()) {
-      if (within(ddq_prev, ddq_step_max) && within(tau - rd.gravity, tau_rate_max)) {
+      if (within(ddq_prev, ddq_step_max) && within(tau - rd.gravity, tau_rate_max) &&
+          (!sim.options.settle_for_stop || can_stop_dead(robot, rd, dq, ddq_prev, dt))) {
         if (moved > 0) {
           const RolloutStatus c = collision_status(sim, ws, q, result.collision_checks);
           if (c != RolloutStatus::Valid) return finish(c, tick);

@@ -48,7 +48,13 @@ struct SimulationOptions {
   int substeps = 1;               // integration steps per control period
   double settle_velocity = 1e-3;  // at rest when every |dq| is below this (rad/s)
   double max_settle_time = 1.0;   // after the command ends, s
-  int sample_every = 20;          // control ticks between stored trajectory samples (0: none)
+  // At rest also means: the arm could stop dead at the next tick (the next command starts from
+  // exactly zero velocity) within the acceleration, jerk and half the torque-rate limit (the
+  // other half is the next command's first tick). For trajectories that are executed, where
+  // that velocity jump between two rest-to-rest commands is real; bundle edges and the
+  // planners keep the paper's settle (off), so edges and their end states do not change.
+  bool settle_for_stop = false;
+  int sample_every = 20;  // control ticks between stored trajectory samples (0: none)
 };
 
 // Stored-sample spacing: control ticks <-> seconds. sample_every_ticks rounds to the nearest
