@@ -23,6 +23,7 @@ struct BuildControl {
   bool quiet = false;
   std::function<bool()> stop_requested;                // polled between rounds
   std::function<void(const Bundle&)> save_checkpoint;  // persists the bundle so far
+  std::function<void(uint64_t done, uint64_t total)> progress;  // valid edges, after each round
 };
 
 struct EdgeAttempt {
