@@ -109,53 +109,73 @@ void bind_bundle(py::module_& m) {
       "open.")
       .def(py::init([](const py::object& path, bool memory_map) {
              const std::string p = py::str(path).cast<std::string>();
-             return file_errors([&] { return std::make_shared<BundleView>(BundleView::open(p, memory_map)); });
+             return file_errors(
+                 [&] { return std::make_shared<BundleView>(BundleView::open(p, memory_map)); });
            }),
            py::arg("path"), py::arg("memory_map") = true,
            "Opens a bundle file. memory_map=False reads every dataset into memory. OSError for "
            "a missing, corrupt or incomplete bundle.")
-      .def_property_readonly("path", &BundleView::path)
-      .def_property_readonly("header", [](const BundleView& v) { return header_dict(v.header()); },
-                             "The header (the file's root attributes) as a dict.")
-      .def_property_readonly("dof", &BundleView::dof)
+      .def_property_readonly("path", &BundleView::path, "The bundle file.")
+      .def_property_readonly(
+          "header", [](const BundleView& v) { return header_dict(v.header()); },
+          "The header (the file's root attributes) as a dict.")
+      .def_property_readonly("dof", &BundleView::dof, "Joints of the robot.")
       .def("__len__", &BundleView::size, "Number of edges.")
       .def_property_readonly("size", &BundleView::size, "Number of edges.")
       .def_property_readonly("memory_mapped", &BundleView::memory_mapped,
                              "True when every dataset is mapped from the file (not read).")
-      .def_property_readonly("warnings", &BundleView::warnings)
+      .def_property_readonly("warnings", &BundleView::warnings,
+                             "Why datasets were read instead of mapped, if any.")
       .def_property_readonly("has_perturbation", &BundleView::has_perturbation,
                              "The bundle holds a finished perturbation analysis.")
-      .def_property_readonly("perturbation_theta",
-                             [](const BundleView& v) -> py::object {
-                               if (!v.has_perturbation()) return py::none();
-                               return py::float_(v.perturbation_theta());
-                             })
-      .def_property_readonly("q0", [](const py::object& s) { return edge_rows(s, false); },
-                             "Edge start states, (N, dof), read-only view.")
-      .def_property_readonly("qf", [](const py::object& s) { return edge_rows(s, true); },
-                             "Edge end states, (N, dof), read-only view.")
-      .def_property_readonly("duration", [](const py::object& s) { return edge_array(s, &BundleView::duration_data); },
-                             "Simulated edge durations including settling, s, (N,).")
-      .def_property_readonly("command_duration", [](const py::object& s) { return edge_array(s, &BundleView::command_duration_data); },
-                             "Durations of the velocity commands, s, (N,).")
-      .def_property_readonly("p_lazy_prop", [](const py::object& s) { return edge_array(s, &BundleView::p_lazy_prop_data); },
-                             "P_lazy_prop per edge (N,), or None without a perturbation analysis.")
-      .def_property_readonly("p_collision", [](const py::object& s) { return edge_array(s, &BundleView::p_collision_data); },
-                             "P_collision per edge (N,), or None without a perturbation analysis.")
-      .def_property_readonly("p_lazy_prop_transfer", [](const py::object& s) { return edge_array(s, &BundleView::p_lazy_prop_transfer_data); },
-                             "P_lazy_prop under displacement transfer (N,), or None.")
-      .def_property_readonly("transfer_max_error", [](const py::object& s) { return edge_array(s, &BundleView::transfer_max_error_data); },
-                             "Largest transfer residual per edge, rad (N,), or None.")
+      .def_property_readonly(
+          "perturbation_theta",
+          [](const BundleView& v) -> py::object {
+            if (!v.has_perturbation()) return py::none();
+            return py::float_(v.perturbation_theta());
+          },
+          "theta of the perturbation analysis, rad; None without one.")
+      .def_property_readonly(
+          "q0", [](const py::object& s) { return edge_rows(s, false); },
+          "Edge start states, (N, dof), read-only view.")
+      .def_property_readonly(
+          "qf", [](const py::object& s) { return edge_rows(s, true); },
+          "Edge end states, (N, dof), read-only view.")
+      .def_property_readonly(
+          "duration", [](const py::object& s) { return edge_array(s, &BundleView::duration_data); },
+          "Simulated edge durations including settling, s, (N,).")
+      .def_property_readonly(
+          "command_duration",
+          [](const py::object& s) { return edge_array(s, &BundleView::command_duration_data); },
+          "Durations of the velocity commands, s, (N,).")
+      .def_property_readonly(
+          "p_lazy_prop",
+          [](const py::object& s) { return edge_array(s, &BundleView::p_lazy_prop_data); },
+          "P_lazy_prop per edge (N,), or None without a perturbation analysis.")
+      .def_property_readonly(
+          "p_collision",
+          [](const py::object& s) { return edge_array(s, &BundleView::p_collision_data); },
+          "P_collision per edge (N,), or None without a perturbation analysis.")
+      .def_property_readonly(
+          "p_lazy_prop_transfer",
+          [](const py::object& s) { return edge_array(s, &BundleView::p_lazy_prop_transfer_data); },
+          "P_lazy_prop under displacement transfer (N,), or None.")
+      .def_property_readonly(
+          "transfer_max_error",
+          [](const py::object& s) { return edge_array(s, &BundleView::transfer_max_error_data); },
+          "Largest transfer residual per edge, rad (N,), or None.")
       .def("command", &command_of, py::arg("edge"),
            "The velocity command of an edge: {'knots': (k, dof) view, 'duration': s}.")
-      .def("inspect",
-           [](const BundleView& v) {
-             const std::string path = v.path();
-             py::gil_scoped_release free;
-             return file_errors([&] { return printed([&](std::FILE* out) { print_inspection(path, out); }); });
-           },
-           "The text of `lazyboe-build --inspect`: header and statistics (durations, "
-           "displacements, coverage, neighbours within theta).")
+      .def(
+          "inspect",
+          [](const BundleView& v) {
+            const std::string path = v.path();
+            py::gil_scoped_release free;
+            return file_errors(
+                [&] { return printed([&](std::FILE* out) { print_inspection(path, out); }); });
+          },
+          "The text of `lazyboe-build --inspect`: header and statistics (durations, "
+          "displacements, coverage, neighbours within theta).")
       .def("__repr__", [](const BundleView& v) {
         return "<lazyboe.Bundle '" + v.path() + "': " + std::to_string(v.size()) + " edges>";
       });

@@ -21,8 +21,7 @@ namespace {
 
 std::string shape_text(const py::array& a) {
   std::string s = "(";
-  for (py::ssize_t i = 0; i < a.ndim(); ++i)
-    s += (i ? ", " : "") + std::to_string(a.shape(i));
+  for (py::ssize_t i = 0; i < a.ndim(); ++i) s += (i ? ", " : "") + std::to_string(a.shape(i));
   return s + (a.ndim() == 1 ? ",)" : ")");
 }
 
@@ -30,15 +29,14 @@ std::string shape_text(const py::array& a) {
 
 JointRows joint_rows(const py::handle& value, int dof, const std::string& name) {
   JointRows r;
-  const std::string expected = "expected " + std::to_string(dof) + " values or an (N, " +
-                               std::to_string(dof) + ") array";
+  const std::string expected =
+      "expected " + std::to_string(dof) + " values or an (N, " + std::to_string(dof) + ") array";
   py::array raw;
   try {
     raw = py::array::ensure(value);
   } catch (const py::error_already_set&) {
   }
-  if (!raw || raw.dtype().kind() == 'O' || raw.dtype().kind() == 'U' ||
-      raw.dtype().kind() == 'S') {
+  if (!raw || raw.dtype().kind() == 'O' || raw.dtype().kind() == 'U' || raw.dtype().kind() == 'S') {
     throw InputError(name + ": " + expected + " of numbers");
   }
   if (!(raw.ndim() == 1 && raw.shape(0) == dof) && !(raw.ndim() == 2 && raw.shape(1) == dof))
@@ -58,8 +56,7 @@ JointRows joint_rows(const py::handle& value, int dof, const std::string& name) 
 void check_same_rows(const JointRows& a, const JointRows& b, const std::string& name_b) {
   if (a.batch != b.batch || a.rows != b.rows) {
     throw InputError(name_b + ": expected the shape of the first argument (" +
-                     (a.batch ? std::to_string(a.rows) + " rows" : std::string("one state")) +
-                     ")");
+                     (a.batch ? std::to_string(a.rows) + " rows" : std::string("one state")) + ")");
   }
 }
 

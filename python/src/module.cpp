@@ -15,7 +15,8 @@ PYBIND11_MODULE(_lazyboe, m) {
   m.doc() = "LazyBoE: kinodynamic motion planning on an edge bundle (the C++ library's types).";
   register_exceptions(m);
   m.attr("__version__") = lazyboe::version();
-  m.def("data_dir", &lazyboe::data_dir, "The bundled data directory (robots, environments, queries).");
+  m.def("data_dir", &lazyboe::data_dir,
+        "The bundled data directory (robots, environments, queries).");
   m.def("default_robot_path", &lazyboe::default_robot_path, "The bundled Panda's robot config.");
   bind_robot(m);
   bind_bundle(m);

@@ -27,7 +27,8 @@ struct PythonControl {
 
   bool stop_requested() {
     py::gil_scoped_acquire gil;
-    if (!error && PyErr_CheckSignals() != 0) error = std::make_exception_ptr(py::error_already_set());
+    if (!error && PyErr_CheckSignals() != 0)
+      error = std::make_exception_ptr(py::error_already_set());
     return static_cast<bool>(error);
   }
   void report(uint64_t done, uint64_t total) {
@@ -51,8 +52,8 @@ void take(const py::object& value, T& into) {
 
 // The build settings from the keywords: lazyboe-build's checks, under the keywords' names.
 struct BuildArgs {
-  py::object edges, seed, region, theta, min_duration, max_duration, knot_interval,
-      velocity_scale, limit_scale, integrator, substeps, sample_interval;
+  py::object edges, seed, region, theta, min_duration, max_duration, knot_interval, velocity_scale,
+      limit_scale, integrator, substeps, sample_interval;
 };
 
 void check_settings(const BuildSettings& s) {
@@ -70,7 +71,8 @@ void check_settings(const BuildSettings& s) {
 }
 
 void apply_region(const py::object& region, const RobotModel& robot, BuildSettings& s) {
-  if (region.is_none() || (py::isinstance<py::str>(region) && region.cast<std::string>() == "default")) {
+  if (region.is_none() ||
+      (py::isinstance<py::str>(region) && region.cast<std::string>() == "default")) {
     s.region_lower = robot.region_lower;
     s.region_upper = robot.region_upper;
   } else if (py::isinstance<py::str>(region) && region.cast<std::string>() == "limits") {
@@ -104,8 +106,8 @@ BuildSettings build_settings(const BuildArgs& a, const BundleHeader* resumed) {
   take(a.limit_scale, s.command.limit_scale);
   take(a.substeps, s.simulation.substeps);
   if (!a.integrator.is_none())
-    s.simulation.integrator =
-        input_errors([&] { return parse_integrator(a.integrator.cast<std::string>(), "integrator"); });
+    s.simulation.integrator = input_errors(
+        [&] { return parse_integrator(a.integrator.cast<std::string>(), "integrator"); });
   check_settings(s);
   return s;
 }
@@ -148,19 +150,25 @@ py::object build(const py::object& out_arg, const py::object& robot_arg, const p
     if (!exists) throw FileError(out + ": cannot resume: no such file");
     existing = file_errors([&] { return read_bundle(out); });
   } else if (exists && !force) {
-    throw FileError(out + ": already exists (use force=True to overwrite, or resume=True to continue it)");
+    throw FileError(
+        out + ": already exists (use force=True to overwrite, or resume=True to continue it)");
   }
   BuildSettings s = build_settings(args, resume ? &existing.header : nullptr);
   double sample_interval = resume ? existing.header.sample_interval : 0.05;
   take(args.sample_interval, sample_interval);
   if (!(sample_interval >= 0)) throw InputError("sample_interval: must be >= 0");
-  std::string robot_path = robot_arg.is_none() ? (resume ? existing.header.robot_config : default_robot_path()) : path_text(robot_arg);
-  std::string env_path = env_arg.is_none() ? (resume ? existing.header.env_file : default_environment_path()) : path_text(env_arg);
+  std::string robot_path = robot_arg.is_none()
+                               ? (resume ? existing.header.robot_config : default_robot_path())
+                               : path_text(robot_arg);
+  std::string env_path = env_arg.is_none()
+                             ? (resume ? existing.header.env_file : default_environment_path())
+                             : path_text(env_arg);
   const RobotModel robot = file_errors([&] { return load_robot(robot_path); });
   const Environment env = file_errors([&] { return load_environment(env_path); });
   const CollisionModel collision = input_errors([&] { return build_collision_model(robot, env); });
-  s.simulation.sample_every = input_errors(
-      [&] { return exact_sample_every_ticks(sample_interval, robot.control_rate, "sample_interval"); });
+  s.simulation.sample_every = input_errors([&] {
+    return exact_sample_every_ticks(sample_interval, robot.control_rate, "sample_interval");
+  });
   if (!resume || !args.region.is_none()) apply_region(args.region, robot, s);
   const Simulator sim(robot, collision, s.simulation);
   input_errors([&] { check_region(sim, s); });
@@ -228,15 +236,18 @@ py::object perturb(const py::object& path_arg, const py::object& theta_arg, uint
 void bind_offline(py::module_& m) {
   m.def(
       "build_bundle",
-      [](const py::object& out, const py::object& robot, const py::object& env, const py::object& edges,
-         const py::object& seed, const py::object& region, const py::object& theta,
-         const py::object& min_duration, const py::object& max_duration, const py::object& knot_interval,
-         const py::object& velocity_scale, const py::object& limit_scale, const py::object& integrator,
-         const py::object& substeps, const py::object& sample_interval, int threads,
-         double checkpoint_seconds, bool resume, bool force, const py::object& progress, bool quiet) {
-        const BuildArgs a{edges, seed, region, theta, min_duration, max_duration, knot_interval,
-                          velocity_scale, limit_scale, integrator, substeps, sample_interval};
-        return build(out, robot, env, a, threads, checkpoint_seconds, resume, force, progress, quiet);
+      [](const py::object& out, const py::object& robot, const py::object& env,
+         const py::object& edges, const py::object& seed, const py::object& region,
+         const py::object& theta, const py::object& min_duration, const py::object& max_duration,
+         const py::object& knot_interval, const py::object& velocity_scale,
+         const py::object& limit_scale, const py::object& integrator, const py::object& substeps,
+         const py::object& sample_interval, int threads, double checkpoint_seconds, bool resume,
+         bool force, const py::object& progress, bool quiet) {
+        const BuildArgs a{edges,        seed,         region,        theta,
+                          min_duration, max_duration, knot_interval, velocity_scale,
+                          limit_scale,  integrator,   substeps,      sample_interval};
+        return build(out, robot, env, a, threads, checkpoint_seconds, resume, force, progress,
+                     quiet);
       },
       py::arg("out"), py::kw_only(), py::arg("robot") = py::none(), py::arg("env") = py::none(),
       py::arg("edges") = py::none(), py::arg("seed") = py::none(), py::arg("region") = py::none(),

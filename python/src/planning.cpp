@@ -82,9 +82,9 @@ PyResult answer(const Session& s, SimulatorWorkspace& ws, RolloutPool& pool, con
   return r;
 }
 
-nlohmann::json query_doc(const py::object& start, const py::object& goal, const std::string& planner,
-                         const py::object& budget, const py::object& seed, const std::string& id,
-                         const py::kwargs& params) {
+nlohmann::json query_doc(const py::object& start, const py::object& goal,
+                         const std::string& planner, const py::object& budget,
+                         const py::object& seed, const std::string& id, const py::kwargs& params) {
   nlohmann::json doc = nlohmann::json::object();
   doc["id"] = id;
   doc["start"] = to_json(start, "start");
@@ -159,10 +159,14 @@ py::dict parameter_dict(const ParameterSpec& p) {
   d["type"] = types[static_cast<int>(p.type)];
   py::object def = py::none();
   if (p.has_fixed_default()) {
-    if (p.type == ParameterType::Boolean) def = py::bool_(p.default_value != 0);
-    else if (p.type == ParameterType::Integer) def = py::int_(static_cast<int64_t>(p.default_value));
-    else if (p.type == ParameterType::Choice) def = py::str(p.choices.at(static_cast<size_t>(p.default_value)));
-    else def = py::float_(p.default_value);
+    if (p.type == ParameterType::Boolean)
+      def = py::bool_(p.default_value != 0);
+    else if (p.type == ParameterType::Integer)
+      def = py::int_(static_cast<int64_t>(p.default_value));
+    else if (p.type == ParameterType::Choice)
+      def = py::str(p.choices.at(static_cast<size_t>(p.default_value)));
+    else
+      def = py::float_(p.default_value);
   }
   d["default"] = def;
   d["default_from"] = p.default_from.empty() ? py::object(py::none()) : py::str(p.default_from);
@@ -197,40 +201,80 @@ void bind_result(py::module_& m) {
       .def_readonly("t", &PyTrajectory::t, "Sample times, s, (T,).")
       .def_readonly("q", &PyTrajectory::q, "Joint positions, (T, dof).")
       .def_readonly("dq", &PyTrajectory::dq, "Joint velocities, (T, dof).")
-      .def_readonly("edges", &PyTrajectory::edges, "Bundle edge of each step (-1: not a bundle edge).")
+      .def_readonly("edges", &PyTrajectory::edges,
+                    "Bundle edge of each step (-1: not a bundle edge).")
       .def_readonly("cost", &PyTrajectory::cost, "Joint-space arc length, rad.")
       .def_readonly("duration", &PyTrajectory::duration, "s.")
       .def("__len__", [](const PyTrajectory& t) { return t.t.size(); });
 
-  auto opt = [](bool present, double v) -> py::object { return present ? py::object(py::float_(v)) : py::object(py::none()); };
+  auto opt = [](bool present, double v) -> py::object {
+    return present ? py::object(py::float_(v)) : py::object(py::none());
+  };
   py::class_<PyResult>(m, "PlanResult", "The answer to one query, with the result line's names.")
-      .def_property_readonly("id", [](const PyResult& r) { return r.query.id; })
-      .def_property_readonly("planner", [](const PyResult& r) { return r.query.planner; })
-      .def_property_readonly("success", [](const PyResult& r) { return r.result.success; })
-      .def_property_readonly("time_to_first_solution", [opt](const PyResult& r) { return opt(r.result.success, r.result.time_to_first_solution); },
-                             "Seconds to the first solution; None without one.")
-      .def_property_readonly("n_solutions", [](const PyResult& r) { return r.result.n_solutions; })
-      .def_property_readonly("best_cost", [opt](const PyResult& r) { return opt(r.result.success, r.trajectory.cost); },
-                             "Joint-space arc length of the realized best path, rad; None without one.")
-      .def_property_readonly("counters", [](const PyResult& r) { return from_json(r.json()["counters"]); },
-                             "{'nodes', 'simulations', 'lazy_edges', 'collision_checks'}.")
-      .def_property_readonly("failure", [](const PyResult& r) -> py::object { return r.result.success ? py::object(py::none()) : py::str(r.result.failure); },
-                             "Why there is no solution; None with one.")
-      .def_property_readonly("found_by", [](const PyResult& r) -> py::object { return r.result.found_by.empty() || !r.result.success ? py::object(py::none()) : py::str(r.result.found_by); })
-      .def_property_readonly("duration", [opt](const PyResult& r) { return opt(r.result.success, r.trajectory.duration); },
-                             "Duration of the trajectory, s; None without one.")
-      .def_property_readonly("edges", [](const PyResult& r) -> py::object {
-             if (!r.result.success) return py::none();
-             return trajectory_of(r.trajectory, 0).edges;
-           }, "Bundle edge of each step of the best path (-1: not a bundle edge); None without one.")
-      .def_property_readonly("trajectory", [](const PyResult& r) -> py::object {
-             if (!r.result.success) return py::none();
-             return py::cast(trajectory_of(r.trajectory, static_cast<int>(r.query.problem.start.size())));
-           }, "The realized trajectory (t, q, dq, edges, cost, duration); None without a solution.")
-      .def("to_dict", [](const PyResult& r) { return from_json(r.json()); },
-           "The result line of lazyboe-query --trajectories inline, as a dict.")
+      .def_property_readonly(
+          "id", [](const PyResult& r) { return r.query.id; }, "The query id.")
+      .def_property_readonly(
+          "planner", [](const PyResult& r) { return r.query.planner; },
+          "The planner that answered.")
+      .def_property_readonly(
+          "success", [](const PyResult& r) { return r.result.success; },
+          "A solution was found (and realized).")
+      .def_property_readonly(
+          "time_to_first_solution",
+          [opt](const PyResult& r) {
+            return opt(r.result.success, r.result.time_to_first_solution);
+          },
+          "Seconds to the first solution; None without one.")
+      .def_property_readonly(
+          "n_solutions", [](const PyResult& r) { return r.result.n_solutions; },
+          "Solutions found within the budget.")
+      .def_property_readonly(
+          "best_cost",
+          [opt](const PyResult& r) { return opt(r.result.success, r.trajectory.cost); },
+          "Joint-space arc length of the realized best path, rad; None without one.")
+      .def_property_readonly(
+          "counters", [](const PyResult& r) { return from_json(r.json()["counters"]); },
+          "{'nodes', 'simulations', 'lazy_edges', 'collision_checks'}.")
+      .def_property_readonly(
+          "failure",
+          [](const PyResult& r) -> py::object {
+            return r.result.success ? py::object(py::none()) : py::str(r.result.failure);
+          },
+          "Why there is no solution; None with one.")
+      .def_property_readonly(
+          "found_by",
+          [](const PyResult& r) -> py::object {
+            return r.result.found_by.empty() || !r.result.success ? py::object(py::none())
+                                                                  : py::str(r.result.found_by);
+          },
+          "Which part of the planner found the best path (lazysp: bundle or growth), or None.")
+      .def_property_readonly(
+          "duration",
+          [opt](const PyResult& r) { return opt(r.result.success, r.trajectory.duration); },
+          "Duration of the trajectory, s; None without one.")
+      .def_property_readonly(
+          "edges",
+          [](const PyResult& r) -> py::object {
+            if (!r.result.success) return py::none();
+            return trajectory_of(r.trajectory, 0).edges;
+          },
+          "Bundle edge of each step of the best path (-1: not a bundle edge); None without one.")
+      .def_property_readonly(
+          "trajectory",
+          [](const PyResult& r) -> py::object {
+            if (!r.result.success) return py::none();
+            return py::cast(
+                trajectory_of(r.trajectory, static_cast<int>(r.query.problem.start.size())));
+          },
+          "The realized trajectory (t, q, dq, edges, cost, duration); None without a solution.")
+      .def(
+          "to_dict", [](const PyResult& r) { return from_json(r.json()); },
+          "The result line of lazyboe-query --trajectories inline, as a dict.")
       .def("__repr__", [](const PyResult& r) {
-        return "<lazyboe.PlanResult " + r.query.planner + (r.result.success ? ": solved, cost " + std::to_string(r.trajectory.cost) : ": " + r.result.failure) + ">";
+        return "<lazyboe.PlanResult " + r.query.planner +
+               (r.result.success ? ": solved, cost " + std::to_string(r.trajectory.cost)
+                                 : ": " + r.result.failure) +
+               ">";
       });
 }
 
@@ -247,14 +291,16 @@ void bind_planning(py::module_& m) {
                       "A bundle opened once for planning (memory-mapped), with its robot, "
                       "environment, simulator and neighbour indexes. Thread-safe: plan() "
                       "releases the GIL, so Python threads plan in parallel.")
-      .def(py::init([](const py::object& path, bool memory_map, const py::object& robot, const py::object& env) {
+      .def(py::init([](const py::object& path, bool memory_map, const py::object& robot,
+                       const py::object& env) {
              const std::string p = py::str(path).cast<std::string>();
              const std::string r = robot.is_none() ? "" : py::str(robot).cast<std::string>();
              const std::string e = env.is_none() ? "" : py::str(env).cast<std::string>();
              Session s;
              {
                py::gil_scoped_release free;
-               s.session = file_errors([&] { return std::make_shared<const PlanningSession>(p, memory_map, r, e); });
+               s.session = file_errors(
+                   [&] { return std::make_shared<const PlanningSession>(p, memory_map, r, e); });
              }
              s.context = std::make_unique<const PlanningContext>(s.session->context());
              return s;
@@ -279,15 +325,25 @@ void bind_planning(py::module_& m) {
            "Plans a batch of queries (dicts in the query format: start, goal, planner, budget, "
            "seed, parameters; id optional) on `jobs` threads (0: all cores); results in input "
            "order. Every query is checked before any is planned.")
-      .def_property_readonly("robot", [](const Session& s) {
-             return PyRobot{std::shared_ptr<const RobotModel>(s.session, &s.session->scene.robot)};
-           }, "The bundle's robot (a lazyboe.Robot).")
-      .def_property_readonly("bundle", [](const Session& s) {
-             return make_bundle_object(std::shared_ptr<const BundleView>(s.session, &s.session->bundle));
-           }, "The bundle (a lazyboe.Bundle sharing the session's mapping).")
-      .def_property_readonly("load_seconds", [](const Session& s) { return s.session->load_seconds; })
-      .def_property_readonly("default_theta", [](const Session& s) { return s.session->default_theta(); },
-                             "theta of the bundle's perturbation analysis (or its design theta).");
+      .def_property_readonly(
+          "robot",
+          [](const Session& s) {
+            return PyRobot{std::shared_ptr<const RobotModel>(s.session, &s.session->scene.robot)};
+          },
+          "The bundle's robot (a lazyboe.Robot).")
+      .def_property_readonly(
+          "bundle",
+          [](const Session& s) {
+            return make_bundle_object(
+                std::shared_ptr<const BundleView>(s.session, &s.session->bundle));
+          },
+          "The bundle (a lazyboe.Bundle sharing the session's mapping).")
+      .def_property_readonly(
+          "load_seconds", [](const Session& s) { return s.session->load_seconds; },
+          "Wall time of opening the session, s.")
+      .def_property_readonly(
+          "default_theta", [](const Session& s) { return s.session->default_theta(); },
+          "theta of the bundle's perturbation analysis (or its design theta).");
 }
 
 }  // namespace lazyboe::python

@@ -137,7 +137,8 @@ struct CollisionChecker {
 
 std::shared_ptr<const Environment> environment_of(const py::object& env) {
   if (env.is_none())
-    return file_errors([] { return std::make_shared<Environment>(load_environment(default_environment_path())); });
+    return file_errors(
+        [] { return std::make_shared<Environment>(load_environment(default_environment_path())); });
   if (py::isinstance<Environment>(env)) return env.cast<std::shared_ptr<Environment>>();
   const std::string path = py::str(env).cast<std::string>();  // str or os.PathLike
   return file_errors([&] { return std::make_shared<Environment>(load_environment(path)); });
@@ -156,14 +157,17 @@ std::vector<std::string> link_names(const RobotModel& m) {
 
 void bind_environment(py::module_& m) {
   py::class_<Environment, std::shared_ptr<Environment>>(
-      m, "Environment", "A static environment: named primitive obstacles (an environment JSON file).")
-      .def(py::init([](const py::object& path) { return std::const_pointer_cast<Environment>(environment_of(path)); }),
+      m, "Environment",
+      "A static environment: named primitive obstacles (an environment JSON file).")
+      .def(py::init([](const py::object& path) {
+             return std::const_pointer_cast<Environment>(environment_of(path));
+           }),
            py::arg("path") = py::none(),
            "Loads an environment file (default: the bundled table.json). OSError for a missing "
            "or malformed file.")
-      .def_readonly("name", &Environment::name)
-      .def_readonly("path", &Environment::path)
-      .def_readonly("description", &Environment::description)
+      .def_readonly("name", &Environment::name, "Its name.")
+      .def_readonly("path", &Environment::path, "The file it was read from.")
+      .def_readonly("description", &Environment::description, "Its description.")
       .def_property_readonly(
           "obstacles",
           [](const Environment& e) {
@@ -175,6 +179,134 @@ void bind_environment(py::module_& m) {
       .def("__repr__", [](const Environment& e) {
         return "<lazyboe.Environment '" + e.name + "': " + std::to_string(e.obstacles.size()) +
                " obstacles>";
+      });
+}
+
+void bind_robot_properties(py::class_<PyRobot>& c) {
+  c.def_property_readonly(
+       "name", [](const PyRobot& r) { return r.model->name; }, "The robot config's name.")
+      .def_property_readonly(
+          "config_path", [](const PyRobot& r) { return r.model->config_path; },
+          "The robot config file.")
+      .def_property_readonly(
+          "dof", [](const PyRobot& r) { return r.model->dof; }, "Joints of the chain.")
+      .def_property_readonly(
+          "control_rate", [](const PyRobot& r) { return r.model->control_rate; },
+          "Control ticks per second, Hz.")
+      .def_property_readonly(
+          "joint_names", [](const PyRobot& r) { return joint_names(*r.model); },
+          "Joint names, in chain order.")
+      .def_property_readonly(
+          "link_names", [](const PyRobot& r) { return link_names(*r.model); },
+          "Every link of the chain, base first; the last is the tip.")
+      .def_property_readonly(
+          "lower", [](const PyRobot& r) { return to_array(r.model->q_min); },
+          "Joint position lower limits (rad or m).")
+      .def_property_readonly(
+          "upper", [](const PyRobot& r) { return to_array(r.model->q_max); },
+          "Joint position upper limits (rad or m).")
+      .def_property_readonly(
+          "velocity_limits", [](const PyRobot& r) { return to_array(r.model->dq_max); },
+          "Joint velocity limits (rad/s or m/s).")
+      .def_property_readonly(
+          "acceleration_limits", [](const PyRobot& r) { return to_array(r.model->ddq_max); },
+          "Joint acceleration limits.")
+      .def_property_readonly(
+          "jerk_limits", [](const PyRobot& r) { return to_array(r.model->dddq_max); },
+          "Joint jerk limits.")
+      .def_property_readonly(
+          "effort_limits", [](const PyRobot& r) { return to_array(r.model->tau_max); },
+          "Joint torque (force) limits.")
+      .def_property_readonly(
+          "torque_rate_limits", [](const PyRobot& r) { return to_array(r.model->dtau_max); },
+          "Joint torque rate limits.")
+      .def_property_readonly(
+          "region_lower", [](const PyRobot& r) { return to_array(r.model->region_lower); },
+          "Default sampling box of bundle start states, lower corner.")
+      .def_property_readonly(
+          "region_upper", [](const PyRobot& r) { return to_array(r.model->region_upper); },
+          "Default sampling box of bundle start states, upper corner.");
+}
+
+void bind_robot_algorithms(py::class_<PyRobot>& c) {
+  c.def(
+       "forward_kinematics",
+       [](const PyRobot& r, const py::handle& q, const py::object& link) {
+         return forward_kinematics_of(r.model, q, link);
+       },
+       py::arg("q"), py::arg("link") = py::none(),
+       "Pose of `link` (default: the tip) in the base frame as a 4x4 homogeneous transform; "
+       "(N, 4, 4) for an (N, dof) array of q.")
+      .def(
+          "inverse_dynamics",
+          [](const PyRobot& r, const py::handle& q, const py::handle& dq, const py::handle& ddq) {
+            return per_row<3>(r.model, {q, dq, ddq}, {"q", "dq", "ddq"},
+                              [&](RobotData& d, const std::array<JointRows, 3>& a,
+                                  py::ssize_t k) -> const JointVector& {
+                                return inverse_dynamics(*r.model, d, row_of(a[0], k),
+                                                        row_of(a[1], k), row_of(a[2], k));
+                              });
+          },
+          py::arg("q"), py::arg("dq"), py::arg("ddq"),
+          "Joint torques tau = M(q) ddq + C(q, dq) dq + g(q) + tau_f(dq), friction included "
+          "(recursive Newton-Euler); one row per row of (N, dof) arrays.")
+      .def(
+          "forward_dynamics",
+          [](const PyRobot& r, const py::handle& q, const py::handle& dq, const py::handle& tau) {
+            return per_row<3>(r.model, {q, dq, tau}, {"q", "dq", "tau"},
+                              [&](RobotData& d, const std::array<JointRows, 3>& a,
+                                  py::ssize_t k) -> const JointVector& {
+                                return forward_dynamics(*r.model, d, row_of(a[0], k),
+                                                        row_of(a[1], k), row_of(a[2], k));
+                              });
+          },
+          py::arg("q"), py::arg("dq"), py::arg("tau"),
+          "Joint accelerations ddq = M^-1 (tau - C dq - g - tau_f); one row per row of (N, dof) "
+          "arrays.")
+      .def(
+          "gravity_torques",
+          [](const PyRobot& r, const py::handle& q) {
+            return per_row<1>(r.model, {q}, {"q"},
+                              [&](RobotData& d, const std::array<JointRows, 1>& a,
+                                  py::ssize_t k) -> const JointVector& {
+                                return gravity_torques(*r.model, d, row_of(a[0], k));
+                              });
+          },
+          py::arg("q"), "Gravity torques g(q).")
+      .def(
+          "friction_torques",
+          [](const PyRobot& r, const py::handle& dq) {
+            return per_row<1>(r.model, {dq}, {"dq"},
+                              [&](RobotData& d, const std::array<JointRows, 1>& a,
+                                  py::ssize_t k) -> const JointVector& {
+                                return friction_torques(*r.model, d, row_of(a[0], k));
+                              });
+          },
+          py::arg("dq"), "Joint friction torques tau_f(dq).")
+      .def(
+          "mass_matrix",
+          [](const PyRobot& r, const py::handle& q) { return mass_matrix_of(r.model, q); },
+          py::arg("q"),
+          "Joint-space mass matrix M(q) (dof x dof; (N, dof, dof) for an (N, dof) array).")
+      .def(
+          "collision_checker",
+          [](const PyRobot& r, const py::object& env) {
+            return CollisionChecker(r.model, environment_of(env));
+          },
+          py::arg("env") = py::none(),
+          "The collision model in `env` (an Environment or a path; default: the bundled "
+          "table.json), to check many states.")
+      .def(
+          "in_collision",
+          [](const PyRobot& r, const py::handle& q, const py::object& env) {
+            return CollisionChecker(r.model, environment_of(env)).in_collision(q);
+          },
+          py::arg("q"), py::arg("env") = py::none(),
+          "collision_checker(env).in_collision(q): True when q collides; a bool array for an "
+          "(N, dof) array.")
+      .def("__repr__", [](const PyRobot& r) {
+        return "<lazyboe.Robot '" + r.model->name + "': " + std::to_string(r.model->dof) +
+               " joints>";
       });
 }
 
@@ -192,94 +324,19 @@ void bind_robot(py::module_& m) {
            "Exact smallest distance over the tested pairs, m (0 when touching); an array for "
            "an (N, dof) array.");
 
-  py::class_<PyRobot>(m, "Robot", "A robot model: a serial chain from a robot config and its URDF.")
-      .def(py::init([](const py::object& config) {
-             const std::string path =
-                 config.is_none() ? default_robot_path() : py::str(config).cast<std::string>();
-             return PyRobot{file_errors([&] { return std::make_shared<RobotModel>(load_robot(path)); })};
-           }),
-           py::arg("config") = py::none(),
-           "Loads a robot config (JSON) and its URDF (default: the bundled Panda). OSError "
-           "naming the file and field for anything missing or malformed.")
-      .def_property_readonly("name", [](const PyRobot& r) { return r.model->name; })
-      .def_property_readonly("config_path", [](const PyRobot& r) { return r.model->config_path; })
-      .def_property_readonly("dof", [](const PyRobot& r) { return r.model->dof; })
-      .def_property_readonly("control_rate", [](const PyRobot& r) { return r.model->control_rate; },
-                             "Control ticks per second, Hz.")
-      .def_property_readonly("joint_names", [](const PyRobot& r) { return joint_names(*r.model); })
-      .def_property_readonly("link_names", [](const PyRobot& r) { return link_names(*r.model); },
-                             "Every link of the chain, base first; the last is the tip.")
-      .def_property_readonly("lower", [](const PyRobot& r) { return to_array(r.model->q_min); },
-                             "Joint position lower limits (rad or m).")
-      .def_property_readonly("upper", [](const PyRobot& r) { return to_array(r.model->q_max); },
-                             "Joint position upper limits (rad or m).")
-      .def_property_readonly("velocity_limits", [](const PyRobot& r) { return to_array(r.model->dq_max); })
-      .def_property_readonly("acceleration_limits", [](const PyRobot& r) { return to_array(r.model->ddq_max); })
-      .def_property_readonly("jerk_limits", [](const PyRobot& r) { return to_array(r.model->dddq_max); })
-      .def_property_readonly("effort_limits", [](const PyRobot& r) { return to_array(r.model->tau_max); })
-      .def_property_readonly("torque_rate_limits", [](const PyRobot& r) { return to_array(r.model->dtau_max); })
-      .def_property_readonly("region_lower", [](const PyRobot& r) { return to_array(r.model->region_lower); },
-                             "Default sampling box of bundle start states, lower corner.")
-      .def_property_readonly("region_upper", [](const PyRobot& r) { return to_array(r.model->region_upper); })
-      .def("forward_kinematics",
-           [](const PyRobot& r, const py::handle& q, const py::object& link) {
-             return forward_kinematics_of(r.model, q, link);
-           },
-           py::arg("q"), py::arg("link") = py::none(),
-           "Pose of `link` (default: the tip) in the base frame as a 4x4 homogeneous transform; "
-           "(N, 4, 4) for an (N, dof) array of q.")
-      .def("inverse_dynamics",
-           [](const PyRobot& r, const py::handle& q, const py::handle& dq, const py::handle& ddq) {
-             return per_row<3>(r.model, {q, dq, ddq}, {"q", "dq", "ddq"},
-                               [&](RobotData& d, const std::array<JointRows, 3>& a, py::ssize_t k) -> const JointVector& {
-                                 return inverse_dynamics(*r.model, d, row_of(a[0], k), row_of(a[1], k), row_of(a[2], k));
-                               });
-           },
-           py::arg("q"), py::arg("dq"), py::arg("ddq"),
-           "Joint torques tau = M(q) ddq + C(q, dq) dq + g(q) + tau_f(dq), friction included "
-           "(recursive Newton-Euler); one row per row of (N, dof) arrays.")
-      .def("forward_dynamics",
-           [](const PyRobot& r, const py::handle& q, const py::handle& dq, const py::handle& tau) {
-             return per_row<3>(r.model, {q, dq, tau}, {"q", "dq", "tau"},
-                               [&](RobotData& d, const std::array<JointRows, 3>& a, py::ssize_t k) -> const JointVector& {
-                                 return forward_dynamics(*r.model, d, row_of(a[0], k), row_of(a[1], k), row_of(a[2], k));
-                               });
-           },
-           py::arg("q"), py::arg("dq"), py::arg("tau"),
-           "Joint accelerations ddq = M^-1 (tau - C dq - g - tau_f); one row per row of (N, dof) arrays.")
-      .def("gravity_torques",
-           [](const PyRobot& r, const py::handle& q) {
-             return per_row<1>(r.model, {q}, {"q"},
-                               [&](RobotData& d, const std::array<JointRows, 1>& a, py::ssize_t k) -> const JointVector& {
-                                 return gravity_torques(*r.model, d, row_of(a[0], k));
-                               });
-           },
-           py::arg("q"), "Gravity torques g(q).")
-      .def("friction_torques",
-           [](const PyRobot& r, const py::handle& dq) {
-             return per_row<1>(r.model, {dq}, {"dq"},
-                               [&](RobotData& d, const std::array<JointRows, 1>& a, py::ssize_t k) -> const JointVector& {
-                                 return friction_torques(*r.model, d, row_of(a[0], k));
-                               });
-           },
-           py::arg("dq"), "Joint friction torques tau_f(dq).")
-      .def("mass_matrix", [](const PyRobot& r, const py::handle& q) { return mass_matrix_of(r.model, q); },
-           py::arg("q"), "Joint-space mass matrix M(q) (dof x dof; (N, dof, dof) for an (N, dof) array).")
-      .def("collision_checker",
-           [](const PyRobot& r, const py::object& env) { return CollisionChecker(r.model, environment_of(env)); },
-           py::arg("env") = py::none(),
-           "The collision model in `env` (an Environment or a path; default: the bundled "
-           "table.json), to check many states.")
-      .def("in_collision",
-           [](const PyRobot& r, const py::handle& q, const py::object& env) {
-             return CollisionChecker(r.model, environment_of(env)).in_collision(q);
-           },
-           py::arg("q"), py::arg("env") = py::none(),
-           "collision_checker(env).in_collision(q): True when q collides; a bool array for an "
-           "(N, dof) array.")
-      .def("__repr__", [](const PyRobot& r) {
-        return "<lazyboe.Robot '" + r.model->name + "': " + std::to_string(r.model->dof) + " joints>";
-      });
+  py::class_<PyRobot> robot(m, "Robot",
+                            "A robot model: a serial chain from a robot config and its URDF.");
+  robot.def(
+      py::init([](const py::object& config) {
+        const std::string path =
+            config.is_none() ? default_robot_path() : py::str(config).cast<std::string>();
+        return PyRobot{file_errors([&] { return std::make_shared<RobotModel>(load_robot(path)); })};
+      }),
+      py::arg("config") = py::none(),
+      "Loads a robot config (JSON) and its URDF (default: the bundled Panda). OSError "
+      "naming the file and field for anything missing or malformed.");
+  bind_robot_properties(robot);
+  bind_robot_algorithms(robot);
 }
 
 }  // namespace lazyboe::python
