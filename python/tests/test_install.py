@@ -22,7 +22,7 @@ def test_installed_package_imports(tmp_path):
     out = subprocess.run(
         [sys.executable, "-c", "import lazyboe; r = lazyboe.Robot(); "
          "print(lazyboe.__file__, r.forward_kinematics([0] * 7).shape)"],
-        check=True, capture_output=True, text=True, env=env).stdout
+        check=True, capture_output=True, text=True, env=env, cwd=tmp_path).stdout
     assert out.startswith(str(site / "lazyboe")) and "(4, 4)" in out
     # The default prefix's directory is one Debian's python3 searches.
     assert "/usr/local/lib/" + version + "/dist-packages" in sys.path
