@@ -94,7 +94,7 @@ def threads_figure(session, queries):
 
 
 def cxx_benchmark(tools, name):
-    out = subprocess.run([str(tools.parent / "bench" / "bench_robot"), f"--benchmark_filter=^{name}$",
+    out = subprocess.run([str(tools / "bench_robot"), f"--benchmark_filter=^{name}$",
                           "--benchmark_format=json", "--benchmark_repetitions=3",
                           "--benchmark_report_aggregates_only=true"],
                          check=True, capture_output=True, text=True).stdout

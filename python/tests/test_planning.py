@@ -170,3 +170,26 @@ def test_planners_lists_the_registry():
         assert name in text
         for param in p["parameters"]:
             assert param in text
+
+
+def test_plan_releases_the_gil(session):
+    """While one thread plans (for its whole 2 s budget), another runs Python code: 3,000,000 loop
+    steps (about 50 ms of CPU) finish before the plan does. Holding the GIL, plan() would let
+    the other thread run only before it enters the library (one switch interval, 5 ms)."""
+    started, done = threading.Event(), threading.Event()
+    q = query({"planner": "lazyboe", "seed": 5, "stop_at_first": False, "budget": 2.0})
+
+    def run():
+        started.set()
+        session.plan(**q)
+        done.set()
+
+    worker = threading.Thread(target=run)
+    worker.start()
+    started.wait()
+    steps = 0
+    while steps < 3000000:
+        steps += 1
+    finished_first = not done.is_set()
+    worker.join()
+    assert finished_first
