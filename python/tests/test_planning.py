@@ -193,3 +193,11 @@ def test_plan_releases_the_gil(session):
     finished_first = not done.is_set()
     worker.join()
     assert finished_first
+
+
+def test_planner_needing_what_the_bundle_lacks_raises_runtime_error(unperturbed_path):
+    plain = lazyboe.PlanningSession(unperturbed_path)
+    with pytest.raises(RuntimeError, match="has no complete perturbation analysis"):
+        plain.plan(START, {"q": GOAL}, planner="lazyboe")
+    r = plain.plan(START, {"q": GOAL}, planner="boe", seed=1, stop_at_first=True, budget=20)
+    assert r.success  # BoE needs no analysis
