@@ -6,6 +6,7 @@
 
 #include <exception>
 #include <filesystem>
+#include <type_traits>
 
 #include "convert.h"
 #include "lazyboe/bundle/builder.h"
@@ -45,9 +46,16 @@ struct PythonControl {
 
 std::string path_text(const py::object& p) { return py::str(p).cast<std::string>(); }
 
+// A keyword's value, when given; InputError naming it for a value of the wrong kind.
 template <typename T>
-void take(const py::object& value, T& into) {
-  if (!value.is_none()) into = value.cast<T>();
+void take(const py::object& value, T& into, const std::string& name) {
+  if (value.is_none()) return;
+  try {
+    into = value.cast<T>();
+  } catch (const py::cast_error&) {
+    throw InputError(name + ": expected " +
+                     (std::is_floating_point_v<T> ? "a number" : "a whole number >= 0"));
+  }
 }
 
 // The build settings from the keywords: lazyboe-build's checks, under the keywords' names.
@@ -79,9 +87,10 @@ void apply_region(const py::object& region, const RobotModel& robot, BuildSettin
     s.region_lower = robot.q_min;
     s.region_upper = robot.q_max;
   } else {
-    py::sequence pair = region.cast<py::sequence>();
-    if (py::isinstance<py::str>(region) || pair.size() != 2)
+    if (py::isinstance<py::str>(region) || !py::isinstance<py::sequence>(region) ||
+        py::len(region) != 2)
       throw InputError("region: expected 'default', 'limits' or (lower, upper)");
+    const py::sequence pair = region.cast<py::sequence>();
     const JointRows lo = joint_rows(pair[0], robot.dof, "region lower");
     const JointRows hi = joint_rows(pair[1], robot.dof, "region upper");
     if (lo.batch || hi.batch) throw InputError("region: expected two rows of joint values");
@@ -96,15 +105,15 @@ BuildSettings build_settings(const BuildArgs& a, const BundleHeader* resumed) {
   BuildSettings s;
   s.simulation.integrator = Integrator::SemiImplicitEuler;  // lazyboe-build --integrator euler
   if (resumed) s = input_errors([&] { return settings_from_header(*resumed); });
-  take(a.edges, s.edges);
-  take(a.seed, s.seed);
-  take(a.theta, s.design_theta);
-  take(a.min_duration, s.command.min_duration);
-  take(a.max_duration, s.command.max_duration);
-  take(a.knot_interval, s.command.knot_interval);
-  take(a.velocity_scale, s.command.velocity_scale);
-  take(a.limit_scale, s.command.limit_scale);
-  take(a.substeps, s.simulation.substeps);
+  take(a.edges, s.edges, "edges");
+  take(a.seed, s.seed, "seed");
+  take(a.theta, s.design_theta, "theta");
+  take(a.min_duration, s.command.min_duration, "min_duration");
+  take(a.max_duration, s.command.max_duration, "max_duration");
+  take(a.knot_interval, s.command.knot_interval, "knot_interval");
+  take(a.velocity_scale, s.command.velocity_scale, "velocity_scale");
+  take(a.limit_scale, s.command.limit_scale, "limit_scale");
+  take(a.substeps, s.simulation.substeps, "substeps");
   if (!a.integrator.is_none())
     s.simulation.integrator = input_errors(
         [&] { return parse_integrator(a.integrator.cast<std::string>(), "integrator"); });
@@ -155,7 +164,7 @@ py::object build(const py::object& out_arg, const py::object& robot_arg, const p
   }
   BuildSettings s = build_settings(args, resume ? &existing.header : nullptr);
   double sample_interval = resume ? existing.header.sample_interval : 0.05;
-  take(args.sample_interval, sample_interval);
+  take(args.sample_interval, sample_interval, "sample_interval");
   if (!(sample_interval >= 0)) throw InputError("sample_interval: must be >= 0");
   std::string robot_path = robot_arg.is_none()
                                ? (resume ? existing.header.robot_config : default_robot_path())
@@ -204,7 +213,8 @@ py::object perturb(const py::object& path_arg, const py::object& theta_arg, uint
   PerturbSettings s;
   s.perturbations = perturbations;
   s.seed = seed;
-  s.theta = theta_arg.is_none() ? bundle.header.design_theta : theta_arg.cast<double>();
+  s.theta = bundle.header.design_theta;
+  take(theta_arg, s.theta, "theta");
   if (!(s.theta > 0)) throw InputError("theta: must be > 0");
   const BundleScene scene = file_errors([&] {
     return load_bundle_scene(bundle.header, robot_arg.is_none() ? "" : path_text(robot_arg),

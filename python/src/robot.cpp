@@ -31,6 +31,7 @@ void write_pose(const Pose& pose, double* out) {  // 4 x 4 homogeneous, row-majo
 
 int link_of(const RobotModel& m, const py::object& link) {
   if (link.is_none()) return m.tip_link();
+  if (!py::isinstance<py::str>(link)) throw InputError("link: expected a link name");
   const std::string name = link.cast<std::string>();
   const int k = m.link_index(name);
   if (k < 0) throw InputError("link: unknown link '" + name + "'");

@@ -97,6 +97,7 @@ def test_collision_matches_the_tool(robot, tmp_path):
     (lambda r: r.forward_kinematics([[1, 2], [3]]), "q: expected 7 values"),
     (lambda r: r.forward_kinematics([np.nan] * 7), "q: not a finite number"),
     (lambda r: r.forward_kinematics(READY, link="nope"), "link: unknown link 'nope'"),
+    (lambda r: r.forward_kinematics(READY, link=3), "link: expected a link name"),
     (lambda r: r.inverse_dynamics(np.zeros((3, 7)), np.zeros((2, 7)), np.zeros((3, 7))), "dq: expected the shape"),
     (lambda r: r.inverse_dynamics(READY, np.zeros((2, 7)), READY), "dq: expected the shape"),
     (lambda r: r.mass_matrix(None), "q: expected 7 values"),
