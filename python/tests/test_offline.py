@@ -2,6 +2,8 @@
 (Ctrl-C or an exception in the callback) that leaves a resumable file."""
 
 import signal
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -115,3 +117,33 @@ def test_bad_perturb_settings(bundle_path, tmp_path):
     assert copy.read_bytes() == bundle_path.read_bytes()
     with pytest.raises(OSError, match="missing.h5"):
         lazyboe.perturb_bundle(tmp_path / "missing.h5")
+
+
+BUILD_SCRIPT = """
+import sys, lazyboe
+def progress(done, total):
+    print(done, flush=True)
+try:
+    lazyboe.build_bundle(sys.argv[1], edges=int(sys.argv[2]), threads=1, progress=progress)
+except KeyboardInterrupt:
+    print("interrupted", flush=True)
+    sys.exit(130)
+"""
+
+
+def test_sigint_from_outside_stops_a_build(tmp_path, bundle_path):
+    """A real Ctrl-C (SIGINT to the process while the library builds, not from a callback)."""
+    out = tmp_path / "sigint.h5"
+    script = tmp_path / "build.py"
+    script.write_text(BUILD_SCRIPT)
+    child = subprocess.Popen([sys.executable, str(script), str(out), "100000"],
+                             stdout=subprocess.PIPE, text=True)
+    assert child.stdout.readline().strip() == "0"  # the build has started
+    child.send_signal(signal.SIGINT)
+    rest = child.stdout.read()
+    assert child.wait(timeout=60) == 130 and rest.endswith("interrupted\n")
+    with pytest.raises(OSError):
+        lazyboe.Bundle(out)  # a checkpoint of an unfinished build
+    done = int(rest.split()[-2]) if len(rest.split()) > 1 else 0
+    b = lazyboe.build_bundle(out, resume=True, edges=max(done, 1) + 64)
+    assert len(b) == max(done, 1) + 64
