@@ -4,6 +4,7 @@
 #include <omp.h>
 #include <pybind11/stl.h>
 
+#include <atomic>
 #include <exception>
 #include <memory>
 
@@ -113,20 +114,29 @@ PyResult plan_one(const Session& s, const py::object& start, const py::object& g
   return answer(s, ws, pool, q, every);
 }
 
-std::vector<PyResult> plan_many(const Session& s, const py::iterable& queries, int jobs,
-                                double sample_interval) {
-  if (jobs < 0 || jobs > 1024) throw InputError("jobs: must be in [0, 1024]");
-  if (jobs == 0) jobs = omp_get_num_procs();
-  const int every = s.sample_every(sample_interval);
-  std::vector<nlohmann::json> docs;
-  for (const py::handle& q : queries) {
-    const std::string where = "queries[" + std::to_string(docs.size()) + "]";
-    if (!py::isinstance<py::dict>(q)) throw InputError(where + ": expected a dict (a query)");
-    nlohmann::json doc = to_json(q, where);
-    if (!doc.contains("id")) doc["id"] = std::to_string(docs.size());
-    docs.push_back(std::move(doc));
+// Ctrl-C during a batch: the calling thread (OpenMP's thread 0) looks for a pending signal
+// before each query it takes; once one is seen no query starts any more, and the
+// KeyboardInterrupt is raised after the queries in flight.
+struct BatchInterrupt {
+  std::atomic<bool> seen{false};
+  std::exception_ptr error;
+
+  bool check() {
+    if (seen || omp_get_thread_num() != 0) return seen;
+    py::gil_scoped_acquire gil;
+    if (PyErr_CheckSignals() != 0) {
+      error = std::make_exception_ptr(py::error_already_set());
+      seen = true;
+    }
+    return seen;
   }
-  py::gil_scoped_release free;
+};
+
+// Every query parsed (checked) first, then planned on `jobs` threads; the first error a
+// planner throws is `failure`.
+std::vector<PyResult> plan_parsed(const Session& s, const std::vector<nlohmann::json>& docs,
+                                  int jobs, int every, BatchInterrupt& interrupt,
+                                  std::exception_ptr& failure) {
   std::vector<Query> parsed;
   {
     SimulatorWorkspace ws(s.session->sim);
@@ -141,6 +151,7 @@ std::vector<PyResult> plan_many(const Session& s, const py::iterable& queries, i
     RolloutPool pool(s.session->sim, 1);
 #pragma omp for schedule(dynamic, 1)
     for (long k = 0; k < static_cast<long>(parsed.size()); ++k) {
+      if (interrupt.check()) continue;
       try {
         results[k] = answer(s, ws, pool, parsed[k], every);
       } catch (...) {
@@ -149,7 +160,32 @@ std::vector<PyResult> plan_many(const Session& s, const py::iterable& queries, i
     }
   }
   for (const std::exception_ptr& e : errors)
-    if (e) std::rethrow_exception(e);
+    if (e && !failure) failure = e;
+  return results;
+}
+
+std::vector<PyResult> plan_many(const Session& s, const py::iterable& queries, int jobs,
+                                double sample_interval) {
+  if (jobs < 0 || jobs > 1024) throw InputError("jobs: must be in [0, 1024]");
+  if (jobs == 0) jobs = omp_get_num_procs();
+  const int every = s.sample_every(sample_interval);
+  std::vector<nlohmann::json> docs;
+  for (const py::handle& q : queries) {
+    const std::string where = "queries[" + std::to_string(docs.size()) + "]";
+    if (!py::isinstance<py::dict>(q)) throw InputError(where + ": expected a dict (a query)");
+    nlohmann::json doc = to_json(q, where);
+    if (!doc.contains("id")) doc["id"] = std::to_string(docs.size());
+    docs.push_back(std::move(doc));
+  }
+  BatchInterrupt interrupt;
+  std::exception_ptr failure;
+  std::vector<PyResult> results;
+  {
+    py::gil_scoped_release free;
+    results = plan_parsed(s, docs, jobs, every, interrupt, failure);
+  }
+  if (interrupt.error) std::rethrow_exception(interrupt.error);
+  if (failure) std::rethrow_exception(failure);
   return results;
 }
 
@@ -324,7 +360,8 @@ void bind_planning(py::module_& m) {
            py::arg("sample_interval") = 0.01,
            "Plans a batch of queries (dicts in the query format: start, goal, planner, budget, "
            "seed, parameters; id optional) on `jobs` threads (0: all cores); results in input "
-           "order. Every query is checked before any is planned.")
+           "order. Every query is checked before any is planned. Ctrl-C stops the batch "
+           "after the queries in flight (KeyboardInterrupt).")
       .def_property_readonly(
           "robot",
           [](const Session& s) {

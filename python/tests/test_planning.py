@@ -1,6 +1,9 @@
 """PlanningSession.plan / plan_many: the same answers as lazyboe-query, errors as exceptions."""
 
 import json
+import os
+import signal
+import time
 import threading
 
 import numpy as np
@@ -201,3 +204,18 @@ def test_planner_needing_what_the_bundle_lacks_raises_runtime_error(unperturbed_
         plain.plan(START, {"q": GOAL}, planner="lazyboe")
     r = plain.plan(START, {"q": GOAL}, planner="boe", seed=1, stop_at_first=True, budget=20)
     assert r.success  # BoE needs no analysis
+
+
+def test_ctrl_c_stops_a_batch(session):
+    """SIGINT while plan_many runs 40 queries of 0.5 s each (10 s on two threads): the batch
+    stops after the queries in flight and raises KeyboardInterrupt. (Without the stop, the
+    interrupt would only come after the whole batch.)"""
+    qs = [query({"planner": "lazyboe", "seed": k, "stop_at_first": False, "budget": 0.5})
+          for k in range(40)]
+    timer = threading.Timer(0.3, os.kill, (os.getpid(), signal.SIGINT))
+    start = time.monotonic()
+    timer.start()
+    with pytest.raises(KeyboardInterrupt):
+        session.plan_many(qs, jobs=2)
+    timer.join()
+    assert time.monotonic() - start < 5
