@@ -31,6 +31,8 @@ class Robot:
     config_path: str
     dof: int
     control_rate: float
+    joints: list[dict[str, Any]]
+    links: list[dict[str, Any]]
     joint_names: list[str]
     link_names: list[str]
     lower: npt.NDArray[np.float64]

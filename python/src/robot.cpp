@@ -156,6 +156,42 @@ std::vector<std::string> link_names(const RobotModel& m) {
   return names;
 }
 
+py::list joint_dicts(const RobotModel& m) {
+  static const char* frictions[] = {"none", "sigmoid", "viscous_coulomb"};
+  py::list out;
+  for (const Joint& j : m.joints) {
+    py::dict d, f;
+    d["name"] = j.name;
+    d["type"] = j.type == JointType::Revolute ? "revolute" : "prismatic";
+    d["axis"] = std::vector<double>{j.axis.x(), j.axis.y(), j.axis.z()};
+    d["lower"] = j.lower;
+    d["upper"] = j.upper;
+    d["max_velocity"] = j.max_velocity;
+    d["max_acceleration"] = j.max_acceleration;
+    d["max_jerk"] = j.max_jerk;
+    d["max_effort"] = j.max_effort;
+    d["max_torque_rate"] = j.max_torque_rate;
+    f["model"] = frictions[static_cast<int>(j.friction.model)];
+    f["a"] = j.friction.a;
+    f["b"] = j.friction.b;
+    f["c"] = j.friction.c;
+    d["friction"] = f;
+    out.append(d);
+  }
+  return out;
+}
+
+py::list link_dicts(const RobotModel& m) {
+  py::list out;
+  for (const Link& l : m.links) {
+    py::dict d;
+    d["name"] = l.name;
+    d["body"] = l.body;  // the moving body it is fixed to (joint index); -1 for the base
+    out.append(d);
+  }
+  return out;
+}
+
 void bind_environment(py::module_& m) {
   py::class_<Environment, std::shared_ptr<Environment>>(
       m, "Environment",
@@ -185,7 +221,14 @@ void bind_environment(py::module_& m) {
 
 void bind_robot_properties(py::class_<PyRobot>& c) {
   c.def_property_readonly(
-       "name", [](const PyRobot& r) { return r.model->name; }, "The robot config's name.")
+       "joints", [](const PyRobot& r) { return joint_dicts(*r.model); },
+       "Per joint (chain order) a dict: name, type, axis, lower, upper, max_velocity, "
+       "max_acceleration, max_jerk, max_effort, max_torque_rate, friction {model, a, b, c}.")
+      .def_property_readonly(
+          "links", [](const PyRobot& r) { return link_dicts(*r.model); },
+          "Per link (base first) a dict: name, body (the joint moving it; -1 for the base).")
+      .def_property_readonly(
+          "name", [](const PyRobot& r) { return r.model->name; }, "The robot config's name.")
       .def_property_readonly(
           "config_path", [](const PyRobot& r) { return r.model->config_path; },
           "The robot config file.")

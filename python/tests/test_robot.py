@@ -31,6 +31,14 @@ def test_model(robot):
     assert len(robot.joint_names) == 7 and robot.link_names[-1]
     assert (robot.lower < robot.upper).all()
     assert robot.control_rate == 1000
+    joints = robot.joints
+    assert [j["name"] for j in joints] == robot.joint_names
+    assert [j["lower"] for j in joints] == robot.lower.tolist()
+    assert [j["max_velocity"] for j in joints] == robot.velocity_limits.tolist()
+    assert all(j["type"] == "revolute" and j["friction"]["model"] != "none" for j in joints)
+    links = robot.links
+    assert [l["name"] for l in links] == robot.link_names and links[0]["body"] == -1
+    assert links[-1]["body"] == robot.dof - 1
 
 
 def test_vectorized_equals_one_state(robot, states):
