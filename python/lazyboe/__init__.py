@@ -35,6 +35,7 @@ __all__ = [
     "PlanResult",
     "Robot",
     "Trajectory",
+    "__version__",
     "build_bundle",
     "data_dir",
     "default_robot_path",
