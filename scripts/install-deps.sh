@@ -9,6 +9,8 @@ packages=(
   nlohmann-json3-dev libnanoflann-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   python3 python3-jsonschema
+  # The Python module (python/) and its tests: built for and run by Debian's /usr/bin/python3.
+  pybind11-dev python3-dev python3-numpy python3-pytest
   # Optional for the build (lazyboe-bench skips what is missing, and says so), installed so
   # that the demo and the tests cover OMPL's planners and the benchmark figures.
   libompl-dev python3-matplotlib

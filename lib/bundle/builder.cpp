@@ -202,6 +202,7 @@ BuildOutcome build_bundle(const Simulator& sim, const BuildSettings& settings, B
   auto status_line = [&]() { return "valid " + percent(h.valid, h.attempts); };
 
   progress.update(bundle.size(), status_line());
+  if (control.progress) control.progress(bundle.size(), settings.edges);
   while (bundle.size() < settings.edges) {
     if (control.stop_requested && control.stop_requested()) {
       progress.finish();
@@ -227,6 +228,7 @@ BuildOutcome build_bundle(const Simulator& sim, const BuildSettings& settings, B
       }
     }
     progress.update(bundle.size(), status_line());
+    if (control.progress) control.progress(bundle.size(), settings.edges);
     if (bundle.size() < settings.edges) checkpoints.save_if_due();
   }
   progress.finish();

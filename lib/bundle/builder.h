@@ -21,8 +21,9 @@ struct BuildControl {
   int threads = 0;                 // 0: all available
   double checkpoint_seconds = 10;  // at least this long between checkpoints
   bool quiet = false;
-  std::function<bool()> stop_requested;                // polled between rounds
-  std::function<void(const Bundle&)> save_checkpoint;  // persists the bundle so far
+  std::function<bool()> stop_requested;                         // polled between rounds
+  std::function<void(const Bundle&)> save_checkpoint;           // persists the bundle so far
+  std::function<void(uint64_t done, uint64_t total)> progress;  // valid edges, after each round
 };
 
 struct EdgeAttempt {

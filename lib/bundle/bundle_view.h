@@ -51,6 +51,15 @@ class BundleView {
   double p_lazy_prop_transfer(size_t edge) const { return p_lazy_prop_transfer_[edge]; }
   double transfer_max_error(size_t edge) const { return transfer_max_error_[edge]; }
 
+  // The per-edge arrays themselves (size() values each), for zero-copy views (the Python
+  // module); null when the bundle has none (no analysis, or no transfer statistics).
+  const double* duration_data() const { return duration_; }
+  const double* command_duration_data() const { return command_duration_; }
+  const double* p_lazy_prop_data() const { return p_lazy_prop_; }
+  const double* p_collision_data() const { return p_collision_; }
+  const double* p_lazy_prop_transfer_data() const { return p_lazy_prop_transfer_; }
+  const double* transfer_max_error_data() const { return transfer_max_error_; }
+
   bool memory_mapped() const { return all_mapped_; }  // every dataset mapped
   const std::vector<std::string>& warnings() const { return warnings_; }
 

@@ -191,6 +191,7 @@ PerturbOutcome run_perturbation(const Simulator& sim, Bundle& b, const PerturbSe
   const size_t round = std::max<size_t>(16, 8 * static_cast<size_t>(threads));
   std::vector<EdgePerturbationCounts> counts(round);
   progress.update(finished);
+  if (control.progress) control.progress(finished, n);
   for (size_t start = 0; start < pending.size(); start += round) {
     if (control.stop_requested && control.stop_requested()) {
       progress.finish();
@@ -228,6 +229,7 @@ PerturbOutcome run_perturbation(const Simulator& sim, Bundle& b, const PerturbSe
     }
     finished += count;
     progress.update(finished);
+    if (control.progress) control.progress(finished, n);
     if (finished < n) checkpoints.save_if_due();
   }
   progress.finish();

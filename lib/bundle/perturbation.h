@@ -31,6 +31,7 @@ struct PerturbControl {
   bool quiet = false;
   std::function<bool()> stop_requested;
   std::function<void(const Bundle&)> save_checkpoint;
+  std::function<void(uint64_t done, uint64_t total)> progress;  // finished edges, after each round
 };
 
 // Draws perturbation j of edge `edge` (norm in (0, theta]).

@@ -1,0 +1,386 @@
+// lazyboe.PlanningSession, lazyboe.planners(): queries in the query format's terms (parsed and
+// validated by parse_query, planned by the registry's plan, realized by realize_path, exactly
+// as lazyboe-query does), with the GIL released while planning.
+#include <omp.h>
+#include <pybind11/stl.h>
+
+#include <atomic>
+#include <exception>
+#include <memory>
+
+#include "convert.h"
+#include "lazyboe/io/query_io.h"
+#include "lazyboe/planning/planning_session.h"
+#include "lazyboe/planning/registry.h"
+
+namespace lazyboe::python {
+namespace {
+
+struct PyTrajectory {
+  py::array_t<double> t, q, dq;
+  py::array_t<int64_t> edges;
+  double cost = 0, duration = 0;
+};
+
+// One answered query: what lazyboe-query's result line holds.
+struct PyResult {
+  Query query;
+  PlanResult result;
+  Trajectory trajectory;  // when result.success
+
+  nlohmann::json json() const {
+    return result_json(query, result, result.success ? &trajectory : nullptr,
+                       TrajectoryOutput::Inline, "");
+  }
+};
+
+PyTrajectory trajectory_of(const Trajectory& tr, int dof) {
+  PyTrajectory p;
+  p.t = to_array(tr.t);
+  p.q = rows_to_array(tr.q, dof);
+  p.dq = rows_to_array(tr.dq, dof);
+  p.edges = py::array_t<int64_t>(static_cast<py::ssize_t>(tr.edges.size()));
+  std::copy(tr.edges.begin(), tr.edges.end(), p.edges.mutable_data());
+  p.cost = tr.cost;
+  p.duration = tr.duration;
+  return p;
+}
+
+struct Session {
+  std::shared_ptr<const PlanningSession> session;
+  std::unique_ptr<const PlanningContext> context;
+  int sample_every(double interval) const {
+    if (!(interval > 0)) throw InputError("sample_interval: must be > 0");
+    return std::max(1, sample_every_ticks(interval, session->scene.robot.control_rate));
+  }
+};
+
+// "line 0: goal.q: ..." from parse_query, without the line (there is none in Python).
+std::string without_line(const std::string& what) {
+  const std::string prefix = "line 0: ";
+  return what.rfind(prefix, 0) == 0 ? what.substr(prefix.size()) : what;
+}
+
+Query parse(const Session& s, SimulatorWorkspace& ws, const nlohmann::json& doc,
+            const std::string& where) {
+  std::string id;
+  try {
+    return parse_query(doc.dump(), 0, s.session->scene.robot, s.session->sim, ws, QueryDefaults{},
+                       id);
+  } catch (const Error& e) {
+    throw InputError(where + without_line(e.what()));
+  }
+}
+
+PyResult answer(const Session& s, SimulatorWorkspace& ws, RolloutPool& pool, const Query& q,
+                int sample_every) {
+  PyResult r{q, {}, {}};
+  r.result = plan(*s.context, ws, q.planner, q.parameters, q.problem, &pool);
+  if (r.result.success) {
+    r.trajectory = realize_path(s.session->sim, ws, q.problem.start, r.result.best_path,
+                                q.problem.goal, sample_every);
+  }
+  return r;
+}
+
+nlohmann::json query_doc(const py::object& start, const py::object& goal,
+                         const std::string& planner, const py::object& budget,
+                         const py::object& seed, const std::string& id, const py::kwargs& params) {
+  nlohmann::json doc = nlohmann::json::object();
+  doc["id"] = id;
+  doc["start"] = to_json(start, "start");
+  doc["goal"] = to_json(goal, "goal");
+  doc["planner"] = planner;
+  if (!budget.is_none()) doc["budget"] = to_json(budget, "budget");
+  if (!seed.is_none()) doc["seed"] = to_json(seed, "seed");
+  for (const auto& [k, v] : params) {
+    const std::string name = k.cast<std::string>();
+    doc[name] = to_json(v, name);
+  }
+  return doc;
+}
+
+PyResult plan_one(const Session& s, const py::object& start, const py::object& goal,
+                  const std::string& planner, const py::object& budget, const py::object& seed,
+                  const std::string& id, double sample_interval, int sim_threads,
+                  const py::kwargs& params) {
+  if (sim_threads < 1 || sim_threads > 1024) throw InputError("sim_threads: must be in [1, 1024]");
+  const int every = s.sample_every(sample_interval);
+  const nlohmann::json doc = query_doc(start, goal, planner, budget, seed, id, params);
+  py::gil_scoped_release free;
+  SimulatorWorkspace ws(s.session->sim);
+  const Query q = parse(s, ws, doc, "");
+  RolloutPool pool(s.session->sim, sim_threads);
+  return answer(s, ws, pool, q, every);
+}
+
+// Ctrl-C during a batch: the calling thread (OpenMP's thread 0) looks for a pending signal
+// before each query it takes; once one is seen no query starts any more, and the
+// KeyboardInterrupt is raised after the queries in flight.
+struct BatchInterrupt {
+  std::atomic<bool> seen{false};
+  std::exception_ptr error;
+
+  bool check() {
+    if (seen || omp_get_thread_num() != 0) return seen;
+    py::gil_scoped_acquire gil;
+    if (PyErr_CheckSignals() != 0) {
+      error = std::make_exception_ptr(py::error_already_set());
+      seen = true;
+    }
+    return seen;
+  }
+};
+
+// Every query parsed (checked) first, then planned on `jobs` threads; the first error a
+// planner throws is `failure`.
+std::vector<PyResult> plan_parsed(const Session& s, const std::vector<nlohmann::json>& docs,
+                                  int jobs, int every, BatchInterrupt& interrupt,
+                                  std::exception_ptr& failure) {
+  std::vector<Query> parsed;
+  {
+    SimulatorWorkspace ws(s.session->sim);
+    for (size_t k = 0; k < docs.size(); ++k)
+      parsed.push_back(parse(s, ws, docs[k], "queries[" + std::to_string(k) + "]: "));
+  }
+  std::vector<PyResult> results(parsed.size());
+  std::vector<std::exception_ptr> errors(parsed.size());
+#pragma omp parallel num_threads(jobs)
+  {
+    SimulatorWorkspace ws(s.session->sim);
+    RolloutPool pool(s.session->sim, 1);
+#pragma omp for schedule(dynamic, 1)
+    for (long k = 0; k < static_cast<long>(parsed.size()); ++k) {
+      if (interrupt.check()) continue;
+      try {
+        results[k] = answer(s, ws, pool, parsed[k], every);
+      } catch (...) {
+        errors[k] = std::current_exception();
+      }
+    }
+  }
+  for (const std::exception_ptr& e : errors)
+    if (e && !failure) failure = e;
+  return results;
+}
+
+std::vector<PyResult> plan_many(const Session& s, const py::iterable& queries, int jobs,
+                                double sample_interval) {
+  if (jobs < 0 || jobs > 1024) throw InputError("jobs: must be in [0, 1024]");
+  if (jobs == 0) jobs = omp_get_num_procs();
+  const int every = s.sample_every(sample_interval);
+  std::vector<nlohmann::json> docs;
+  for (const py::handle& q : queries) {
+    const std::string where = "queries[" + std::to_string(docs.size()) + "]";
+    if (!py::isinstance<py::dict>(q)) throw InputError(where + ": expected a dict (a query)");
+    nlohmann::json doc = to_json(q, where);
+    if (!doc.contains("id")) doc["id"] = std::to_string(docs.size());
+    docs.push_back(std::move(doc));
+  }
+  BatchInterrupt interrupt;
+  std::exception_ptr failure;
+  std::vector<PyResult> results;
+  {
+    py::gil_scoped_release free;
+    results = plan_parsed(s, docs, jobs, every, interrupt, failure);
+  }
+  if (interrupt.error) std::rethrow_exception(interrupt.error);
+  if (failure) std::rethrow_exception(failure);
+  return results;
+}
+
+py::dict parameter_dict(const ParameterSpec& p) {
+  static const char* types[] = {"real", "integer", "boolean", "choice"};
+  py::dict d;
+  d["type"] = types[static_cast<int>(p.type)];
+  py::object def = py::none();
+  if (p.has_fixed_default()) {
+    if (p.type == ParameterType::Boolean)
+      def = py::bool_(p.default_value != 0);
+    else if (p.type == ParameterType::Integer)
+      def = py::int_(static_cast<int64_t>(p.default_value));
+    else if (p.type == ParameterType::Choice)
+      def = py::str(p.choices.at(static_cast<size_t>(p.default_value)));
+    else
+      def = py::float_(p.default_value);
+  }
+  d["default"] = def;
+  d["default_from"] = p.default_from.empty() ? py::object(py::none()) : py::str(p.default_from);
+  d["range"] = p.range_text();
+  d["choices"] = p.choices;
+  d["description"] = p.description;
+  return d;
+}
+
+py::list planners() {
+  py::list out;
+  for (const PlannerInfo& info : planner_registry()) {
+    py::dict d, params, needs;
+    d["name"] = info.name;
+    d["description"] = info.description;
+    needs["bundle"] = info.needs.bundle;
+    needs["perturbation"] = info.needs.perturbation;
+    needs["ompl"] = info.needs.ompl;
+    d["needs"] = needs;
+    d["available"] = info.available();
+    for (const ParameterSpec& p : info.parameters) params[py::str(p.name)] = parameter_dict(p);
+    d["parameters"] = params;
+    out.append(d);
+  }
+  return out;
+}
+
+void bind_result(py::module_& m) {
+  py::class_<PyTrajectory>(m, "Trajectory",
+                           "A realized trajectory: the path simulated again from the exact start "
+                           "with every check.")
+      .def_readonly("t", &PyTrajectory::t, "Sample times, s, (T,).")
+      .def_readonly("q", &PyTrajectory::q, "Joint positions, (T, dof).")
+      .def_readonly("dq", &PyTrajectory::dq, "Joint velocities, (T, dof).")
+      .def_readonly("edges", &PyTrajectory::edges,
+                    "Bundle edge of each step (-1: not a bundle edge).")
+      .def_readonly("cost", &PyTrajectory::cost, "Joint-space arc length, rad.")
+      .def_readonly("duration", &PyTrajectory::duration, "s.")
+      .def("__len__", [](const PyTrajectory& t) { return t.t.size(); });
+
+  auto opt = [](bool present, double v) -> py::object {
+    return present ? py::object(py::float_(v)) : py::object(py::none());
+  };
+  py::class_<PyResult>(m, "PlanResult", "The answer to one query, with the result line's names.")
+      .def_property_readonly(
+          "id", [](const PyResult& r) { return r.query.id; }, "The query id.")
+      .def_property_readonly(
+          "planner", [](const PyResult& r) { return r.query.planner; },
+          "The planner that answered.")
+      .def_property_readonly(
+          "success", [](const PyResult& r) { return r.result.success; },
+          "A solution was found (and realized).")
+      .def_property_readonly(
+          "time_to_first_solution",
+          [opt](const PyResult& r) {
+            return opt(r.result.success, r.result.time_to_first_solution);
+          },
+          "Seconds to the first solution; None without one.")
+      .def_property_readonly(
+          "n_solutions", [](const PyResult& r) { return r.result.n_solutions; },
+          "Solutions found within the budget.")
+      .def_property_readonly(
+          "best_cost",
+          [opt](const PyResult& r) { return opt(r.result.success, r.trajectory.cost); },
+          "Joint-space arc length of the realized best path, rad; None without one.")
+      .def_property_readonly(
+          "counters", [](const PyResult& r) { return from_json(r.json()["counters"]); },
+          "{'nodes', 'simulations', 'lazy_edges', 'collision_checks'}.")
+      .def_property_readonly(
+          "failure",
+          [](const PyResult& r) -> py::object {
+            return r.result.success ? py::object(py::none()) : py::str(r.result.failure);
+          },
+          "Why there is no solution; None with one.")
+      .def_property_readonly(
+          "found_by",
+          [](const PyResult& r) -> py::object {
+            return r.result.found_by.empty() || !r.result.success ? py::object(py::none())
+                                                                  : py::str(r.result.found_by);
+          },
+          "Which part of the planner found the best path (lazysp: bundle or growth), or None.")
+      .def_property_readonly(
+          "duration",
+          [opt](const PyResult& r) { return opt(r.result.success, r.trajectory.duration); },
+          "Duration of the trajectory, s; None without one.")
+      .def_property_readonly(
+          "edges",
+          [](const PyResult& r) -> py::object {
+            if (!r.result.success) return py::none();
+            return trajectory_of(r.trajectory, 0).edges;
+          },
+          "Bundle edge of each step of the best path (-1: not a bundle edge); None without one.")
+      .def_property_readonly(
+          "trajectory",
+          [](const PyResult& r) -> py::object {
+            if (!r.result.success) return py::none();
+            return py::cast(
+                trajectory_of(r.trajectory, static_cast<int>(r.query.problem.start.size())));
+          },
+          "The realized trajectory (t, q, dq, edges, cost, duration); None without a solution.")
+      .def(
+          "to_dict", [](const PyResult& r) { return from_json(r.json()); },
+          "The result line of lazyboe-query --trajectories inline, as a dict.")
+      .def("__repr__", [](const PyResult& r) {
+        return "<lazyboe.PlanResult " + r.query.planner +
+               (r.result.success ? ": solved, cost " + std::to_string(r.trajectory.cost)
+                                 : ": " + r.result.failure) +
+               ">";
+      });
+}
+
+}  // namespace
+
+py::object make_bundle_object(std::shared_ptr<const BundleView> view);
+
+void bind_planning(py::module_& m) {
+  bind_result(m);
+  m.def("planners", &planners,
+        "The planner registry: per planner its name, description, needs, availability in this "
+        "build, and parameters (type, default, range, description).");
+  py::class_<Session>(m, "PlanningSession",
+                      "A bundle opened once for planning (memory-mapped), with its robot, "
+                      "environment, simulator and neighbour indexes. Thread-safe: plan() "
+                      "releases the GIL, so Python threads plan in parallel.")
+      .def(py::init([](const py::object& path, bool memory_map, const py::object& robot,
+                       const py::object& env) {
+             const std::string p = py::str(path).cast<std::string>();
+             const std::string r = robot.is_none() ? "" : py::str(robot).cast<std::string>();
+             const std::string e = env.is_none() ? "" : py::str(env).cast<std::string>();
+             Session s;
+             {
+               py::gil_scoped_release free;
+               s.session = file_errors(
+                   [&] { return std::make_shared<const PlanningSession>(p, memory_map, r, e); });
+             }
+             s.context = std::make_unique<const PlanningContext>(s.session->context());
+             return s;
+           }),
+           py::arg("bundle_path"), py::arg("memory_map") = true, py::arg("robot") = py::none(),
+           py::arg("env") = py::none(),
+           "Opens a bundle for planning. robot/env: config and environment files (default: "
+           "those named in the bundle; refused unless they match it). OSError for a missing or "
+           "corrupt bundle or mismatching files.")
+      .def("plan", &plan_one, py::arg("start"), py::arg("goal"), py::arg("planner") = "lazyboe",
+           py::arg("budget") = py::none(), py::arg("seed") = py::none(), py::arg("id") = "",
+           py::arg("sample_interval") = 0.01, py::arg("sim_threads") = 1,
+           "Plans one query, as a line of lazyboe-query would: start (dof values), goal "
+           "({'q': [...], 'tolerance': 0.1} or {'position': [x, y, z], 'tolerance': 0.02, "
+           "'link': name}), planner (lazyboe.planners()), budget (s, default 5), seed (default "
+           "1), and the planner's parameters by name as keywords (stop_at_first=True, "
+           "theta=0.4, ...). sample_interval: trajectory sample spacing, s; sim_threads: "
+           "threads simulating one query's edges (the answer does not depend on it). ValueError "
+           "(with the field's name) for a bad query; returns a PlanResult.")
+      .def("plan_many", &plan_many, py::arg("queries"), py::arg("jobs") = 0,
+           py::arg("sample_interval") = 0.01,
+           "Plans a batch of queries (dicts in the query format: start, goal, planner, budget, "
+           "seed, parameters; id optional) on `jobs` threads (0: all cores); results in input "
+           "order. Every query is checked before any is planned. Ctrl-C stops the batch "
+           "after the queries in flight (KeyboardInterrupt).")
+      .def_property_readonly(
+          "robot",
+          [](const Session& s) {
+            return PyRobot{std::shared_ptr<const RobotModel>(s.session, &s.session->scene.robot)};
+          },
+          "The bundle's robot (a lazyboe.Robot).")
+      .def_property_readonly(
+          "bundle",
+          [](const Session& s) {
+            return make_bundle_object(
+                std::shared_ptr<const BundleView>(s.session, &s.session->bundle));
+          },
+          "The bundle (a lazyboe.Bundle sharing the session's mapping).")
+      .def_property_readonly(
+          "load_seconds", [](const Session& s) { return s.session->load_seconds; },
+          "Wall time of opening the session, s.")
+      .def_property_readonly(
+          "default_theta", [](const Session& s) { return s.session->default_theta(); },
+          "theta of the bundle's perturbation analysis (or its design theta).");
+}
+
+}  // namespace lazyboe::python

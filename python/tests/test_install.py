@@ -1,0 +1,28 @@
+"""`make install` puts the package where Debian's python3 finds it: <prefix>/lib/python3.X/
+dist-packages (for the default prefix /usr/local, on sys.path already)."""
+
+import os
+import subprocess
+import sys
+
+import pytest
+
+
+def test_installed_package_imports(tmp_path):
+    build = os.environ.get("LAZYBOE_BUILD_DIR")
+    if not build:
+        pytest.skip("LAZYBOE_BUILD_DIR not set (run through ctest)")
+    subprocess.run(["cmake", "--install", build, "--component", "python", "--prefix",
+                    str(tmp_path)], check=True, capture_output=True)
+    version = f"python{sys.version_info.major}.{sys.version_info.minor}"
+    site = tmp_path / "lib" / version / "dist-packages"
+    assert (site / "lazyboe" / "__init__.py").is_file()
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
+    env["PYTHONPATH"] = str(site)
+    out = subprocess.run(
+        [sys.executable, "-c", "import lazyboe; r = lazyboe.Robot(); "
+         "print(lazyboe.__file__, r.forward_kinematics([0] * 7).shape)"],
+        check=True, capture_output=True, text=True, env=env, cwd=tmp_path).stdout
+    assert out.startswith(str(site / "lazyboe")) and "(4, 4)" in out
+    # The default prefix's directory is one Debian's python3 searches.
+    assert "/usr/local/lib/" + version + "/dist-packages" in sys.path

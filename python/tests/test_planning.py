@@ -1,0 +1,225 @@
+"""PlanningSession.plan / plan_many: the same answers as lazyboe-query, errors as exceptions."""
+
+import json
+import os
+import signal
+import time
+import threading
+
+import numpy as np
+import pytest
+
+import lazyboe
+from conftest import GOAL, START, tool
+
+# Queries every planner family answers deterministically (stop_at_first, generous budget).
+QUERIES = [
+    {"id": "lazyboe-1", "planner": "lazyboe", "seed": 1},
+    {"id": "lazyboe-7", "planner": "lazyboe", "seed": 7},
+    {"id": "boe-3", "planner": "boe", "seed": 3},
+    {"id": "rrt-2", "planner": "rrt", "seed": 2},
+    {"id": "lazysp-1", "planner": "lazysp", "seed": 1},
+    # The flange to where GOAL puts it (lazyboe-robot fk; rounded as a user would write it).
+    {"id": "lazyboe-position", "planner": "lazyboe", "seed": 1,
+     "goal": {"position": [0.5622, 0.1929, 0.4724], "tolerance": 0.03}},
+    {"id": "rrt-position", "planner": "rrt", "seed": 4,
+     "goal": {"position": [0.5622, 0.1929, 0.4724], "tolerance": 0.03}},
+]
+
+
+def query(q):
+    return {"start": START, "goal": {"q": GOAL, "tolerance": 0.1}, "budget": 20,
+            "stop_at_first": True, **q}
+
+
+@pytest.fixture(scope="module")
+def tool_results(bundle_path, tmp_path_factory):
+    queries = tmp_path_factory.mktemp("queries") / "q.jsonl"
+    queries.write_text("".join(json.dumps(query(q)) + "\n" for q in QUERIES))
+    out = tool("lazyboe-query", "--bundle", bundle_path, "--queries", queries,
+               "--trajectories", "inline", "--quiet").stdout
+    return {r["id"]: r for r in map(json.loads, out.splitlines())}
+
+
+def same_as_tool(result, line):
+    """Every field of the result line but the timing and the line number."""
+    mine = result.to_dict()
+    for d in (mine, line):
+        d.pop("time_to_first_solution")
+        d.pop("line")
+    assert mine == line
+    assert result.success == line["success"]
+    if result.success:
+        assert result.best_cost == line["best_cost"]
+        assert result.edges.tolist() == line["edges"]
+        assert result.trajectory.t.tolist() == line["trajectory"]["t"]
+        assert result.trajectory.q.tolist() == line["trajectory"]["q"]
+        assert result.trajectory.dq.tolist() == line["trajectory"]["dq"]
+
+
+def test_plan_equals_lazyboe_query(session, tool_results):
+    for q in QUERIES:
+        r = session.plan(**query(q))
+        assert r.success, r.failure
+        same_as_tool(r, dict(tool_results[q["id"]]))
+
+
+def test_plan_many_equals_lazyboe_query(session, tool_results):
+    results = session.plan_many([query(q) for q in QUERIES], jobs=2)
+    assert [r.id for r in results] == [q["id"] for q in QUERIES]
+    for r in results:
+        same_as_tool(r, dict(tool_results[r.id]))
+
+
+def test_result_attributes(session):
+    r = session.plan(np.array(START), {"q": np.array(GOAL)}, planner="lazyboe", seed=1,
+                     stop_at_first=True, budget=20)
+    assert r.success and r.failure is None and r.n_solutions >= 1
+    assert r.time_to_first_solution > 0
+    assert set(r.counters) == {"nodes", "simulations", "lazy_edges", "collision_checks"}
+    t = r.trajectory
+    assert t.q.shape == (len(t.t), 7) and t.dq.shape == t.q.shape
+    assert t.q[0].tolist() == START
+    assert np.linalg.norm(t.q[-1] - GOAL) <= 0.1
+    assert t.cost == r.best_cost and t.duration == r.duration == pytest.approx(t.t[-1])
+    assert (np.diff(t.t) > 0).all()
+
+
+def test_position_goal(session, tool_results):
+    robot = session.robot
+    target = robot.forward_kinematics(GOAL)[:3, 3]
+    r = session.plan(START, {"position": target.tolist(), "tolerance": 0.03}, seed=1,
+                     stop_at_first=True, budget=20)
+    assert r.success, r.failure
+    reached = robot.forward_kinematics(r.trajectory.q[-1])[:3, 3]
+    assert np.linalg.norm(reached - target) <= 0.03
+
+
+def test_no_solution_is_a_result(session):
+    r = session.plan(START, {"q": GOAL, "tolerance": 0.1}, planner="rrt", budget=0.001, seed=1)
+    assert not r.success
+    assert r.trajectory is None and r.best_cost is None and r.edges is None
+    assert r.failure
+
+
+@pytest.mark.parametrize("kwargs, message", [
+    (dict(start=START[:6]), "start: expected 7 joint values"),
+    (dict(goal={"q": [9.0] * 7}), "goal.q: "),
+    (dict(goal={"qq": GOAL}), "goal"),
+    (dict(goal={"q": GOAL, "tolerance": -1}), "goal.tolerance"),
+    (dict(planner="nope"), "planner: unknown planner 'nope'"),
+    (dict(theta=-1.0), "theta: must be"),
+    (dict(budget=0), "budget"),
+    (dict(seed=-3), "seed: must be >= 0"),
+    (dict(frobnicate=1), "frobnicate"),
+    (dict(goal={"position": [0.5, 0, 0.5], "link": "nope"}), "goal.link: unknown link 'nope'"),
+    (dict(goal=object()), "goal: cannot be given as object"),
+    (dict(start="abc"), "start"),
+])
+def test_bad_query_raises_value_error(session, kwargs, message):
+    args = {"start": START, "goal": {"q": GOAL}, **kwargs}
+    with pytest.raises(ValueError) as e:
+        session.plan(**args)
+    assert message in str(e.value)
+    assert "\n" not in str(e.value)
+
+
+def test_bad_query_in_a_batch_names_it(session):
+    with pytest.raises(ValueError, match=r"queries\[1\]: start: expected 7 joint values"):
+        session.plan_many([query({}), query({"start": [0.0]})])
+
+
+def test_message_is_the_librarys(session, bundle_path, tmp_path):
+    """The same message as lazyboe-query gives for the same bad query (without its line)."""
+    bad = query({"id": "bad", "goal": {"q": [9.0] * 7}})
+    f = tmp_path / "bad.jsonl"
+    f.write_text(json.dumps(bad) + "\n")
+    line = json.loads(tool("lazyboe-query", "--bundle", bundle_path, "--queries", f,
+                           "--quiet").stdout)
+    with pytest.raises(ValueError) as e:
+        session.plan_many([bad])
+    assert line["error"] == "line 1: " + str(e.value).removeprefix("queries[0]: ")
+
+
+def test_missing_files_raise_os_error(tmp_path):
+    with pytest.raises(OSError, match="nothing.h5"):
+        lazyboe.PlanningSession(tmp_path / "nothing.h5")
+    junk = tmp_path / "junk.h5"
+    junk.write_bytes(b"not a bundle")
+    with pytest.raises(OSError, match="junk.h5"):
+        lazyboe.PlanningSession(junk)
+
+
+def test_threads_plan_concurrently_with_the_same_results(session):
+    qs = [query({"planner": "lazyboe", "seed": s}) for s in (11, 12)]
+    sequential = [session.plan(**q).to_dict() for q in qs]
+    concurrent = [None, None]
+
+    def run(k):
+        concurrent[k] = session.plan(**qs[k]).to_dict()
+
+    threads = [threading.Thread(target=run, args=(k,)) for k in range(2)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    for a, b in zip(sequential, concurrent):
+        a.pop("time_to_first_solution"), b.pop("time_to_first_solution")
+        assert a == b
+
+
+def test_planners_lists_the_registry():
+    ps = {p["name"]: p for p in lazyboe.planners()}
+    assert {"lazyboe", "boe", "rrt", "sst", "lazysp"} <= set(ps)
+    assert ps["lazyboe"]["needs"]["perturbation"]
+    text = tool("lazyboe-query", "--list-planners").stdout
+    for name, p in ps.items():
+        assert name in text
+        for param in p["parameters"]:
+            assert param in text
+
+
+def test_plan_releases_the_gil(session):
+    """While one thread plans (for its whole 2 s budget), another runs Python code: 3,000,000 loop
+    steps (about 50 ms of CPU) finish before the plan does. Holding the GIL, plan() would let
+    the other thread run only before it enters the library (one switch interval, 5 ms)."""
+    started, done = threading.Event(), threading.Event()
+    q = query({"planner": "lazyboe", "seed": 5, "stop_at_first": False, "budget": 2.0})
+
+    def run():
+        started.set()
+        session.plan(**q)
+        done.set()
+
+    worker = threading.Thread(target=run)
+    worker.start()
+    started.wait()
+    steps = 0
+    while steps < 3000000:
+        steps += 1
+    finished_first = not done.is_set()
+    worker.join()
+    assert finished_first
+
+
+def test_planner_needing_what_the_bundle_lacks_raises_runtime_error(unperturbed_path):
+    plain = lazyboe.PlanningSession(unperturbed_path)
+    with pytest.raises(RuntimeError, match="has no complete perturbation analysis"):
+        plain.plan(START, {"q": GOAL}, planner="lazyboe")
+    r = plain.plan(START, {"q": GOAL}, planner="boe", seed=1, stop_at_first=True, budget=20)
+    assert r.success  # BoE needs no analysis
+
+
+def test_ctrl_c_stops_a_batch(session):
+    """SIGINT while plan_many runs 40 queries of 0.5 s each (10 s on two threads): the batch
+    stops after the queries in flight and raises KeyboardInterrupt. (Without the stop, the
+    interrupt would only come after the whole batch.)"""
+    qs = [query({"planner": "lazyboe", "seed": k, "stop_at_first": False, "budget": 0.5})
+          for k in range(40)]
+    timer = threading.Timer(0.3, os.kill, (os.getpid(), signal.SIGINT))
+    start = time.monotonic()
+    timer.start()
+    with pytest.raises(KeyboardInterrupt):
+        session.plan_many(qs, jobs=2)
+    timer.join()
+    assert time.monotonic() - start < 5
