@@ -80,9 +80,12 @@ class Trajectory:
     t: npt.NDArray[np.float64]
     q: npt.NDArray[np.float64]
     dq: npt.NDArray[np.float64]
+    ddq: npt.NDArray[np.float64]
+    cmd: npt.NDArray[np.float64]
     edges: npt.NDArray[np.int64]
     cost: float
     duration: float
+    stops: int
     def __len__(self) -> int: ...
 
 class PlanResult:
@@ -109,9 +112,10 @@ class PlanningSession:
                  env: Optional[Path] = None) -> None: ...
     def plan(self, start: ArrayLike, goal: dict[str, Any], planner: str = "lazyboe",
              budget: Optional[float] = None, seed: Optional[int] = None, id: str = "",
-             sample_interval: float = 0.01, sim_threads: int = 1, **params: Any) -> PlanResult: ...
+             sample_interval: float = 0.01, sim_threads: int = 1, raw: bool = False,
+             **params: Any) -> PlanResult: ...
     def plan_many(self, queries: Iterable[dict[str, Any]], jobs: int = 0,
-                  sample_interval: float = 0.01) -> list[PlanResult]: ...
+                  sample_interval: float = 0.01, raw: bool = False) -> list[PlanResult]: ...
 
 def planners() -> list[dict[str, Any]]: ...
 

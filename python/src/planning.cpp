@@ -1,6 +1,7 @@
 // lazyboe.PlanningSession, lazyboe.planners(): queries in the query format's terms (parsed and
-// validated by parse_query, planned by the registry's plan, realized by realize_path, exactly
-// as lazyboe-query does), with the GIL released while planning.
+// validated by parse_query, planned by the registry's plan, post-processed by make_executable
+// or, raw, realized by realize_path, exactly as lazyboe-query does), with the GIL released
+// while planning.
 #include <omp.h>
 #include <pybind11/stl.h>
 
@@ -10,6 +11,7 @@
 
 #include "convert.h"
 #include "lazyboe/io/query_io.h"
+#include "lazyboe/planning/execution.h"
 #include "lazyboe/planning/planning_session.h"
 #include "lazyboe/planning/registry.h"
 
@@ -17,9 +19,10 @@ namespace lazyboe::python {
 namespace {
 
 struct PyTrajectory {
-  py::array_t<double> t, q, dq;
+  py::array_t<double> t, q, dq, ddq, cmd;  // ddq, cmd: (0, dof) for a raw chain
   py::array_t<int64_t> edges;
   double cost = 0, duration = 0;
+  int stops = 0;
 };
 
 // One answered query: what lazyboe-query's result line holds.
@@ -27,10 +30,12 @@ struct PyResult {
   Query query;
   PlanResult result;
   Trajectory trajectory;  // when result.success
+  bool raw = false;       // the planner's edge chain, not post-processed
+  ExecutionStats execution;
 
   nlohmann::json json() const {
     return result_json(query, result, result.success ? &trajectory : nullptr,
-                       TrajectoryOutput::Inline, "");
+                       TrajectoryOutput::Inline, "", raw ? nullptr : &execution);
   }
 };
 
@@ -39,6 +44,9 @@ PyTrajectory trajectory_of(const Trajectory& tr, int dof) {
   p.t = to_array(tr.t);
   p.q = rows_to_array(tr.q, dof);
   p.dq = rows_to_array(tr.dq, dof);
+  p.ddq = rows_to_array(tr.ddq, dof);
+  p.cmd = rows_to_array(tr.cmd, dof);
+  p.stops = tr.stops;
   p.edges = py::array_t<int64_t>(static_cast<py::ssize_t>(tr.edges.size()));
   std::copy(tr.edges.begin(), tr.edges.end(), p.edges.mutable_data());
   p.cost = tr.cost;
@@ -49,6 +57,7 @@ PyTrajectory trajectory_of(const Trajectory& tr, int dof) {
 struct Session {
   std::shared_ptr<const PlanningSession> session;
   std::unique_ptr<const PlanningContext> context;
+  ExecutionOptions execution;  // lazyboe-query's defaults: the bundle's command limits
   int sample_every(double interval) const {
     if (!(interval > 0)) throw InputError("sample_interval: must be > 0");
     return std::max(1, sample_every_ticks(interval, session->scene.robot.control_rate));
@@ -73,12 +82,18 @@ Query parse(const Session& s, SimulatorWorkspace& ws, const nlohmann::json& doc,
 }
 
 PyResult answer(const Session& s, SimulatorWorkspace& ws, RolloutPool& pool, const Query& q,
-                int sample_every) {
-  PyResult r{q, {}, {}};
+                int sample_every, bool raw) {
+  PyResult r{q, {}, {}, raw, {}};
   r.result = plan(*s.context, ws, q.planner, q.parameters, q.problem, &pool);
-  if (r.result.success) {
+  if (r.result.success && raw) {
     r.trajectory = realize_path(s.session->sim, ws, q.problem.start, r.result.best_path,
                                 q.problem.goal, sample_every);
+  } else if (r.result.success) {
+    ExecutableTrajectory e =
+        make_executable(s.session->sim, ws, q.problem.start, r.result.best_path, q.problem.goal,
+                        s.execution, sample_every);
+    r.trajectory = std::move(e.trajectory);
+    r.execution = e.stats;
   }
   return r;
 }
@@ -102,7 +117,7 @@ nlohmann::json query_doc(const py::object& start, const py::object& goal,
 
 PyResult plan_one(const Session& s, const py::object& start, const py::object& goal,
                   const std::string& planner, const py::object& budget, const py::object& seed,
-                  const std::string& id, double sample_interval, int sim_threads,
+                  const std::string& id, double sample_interval, int sim_threads, bool raw,
                   const py::kwargs& params) {
   if (sim_threads < 1 || sim_threads > 1024) throw InputError("sim_threads: must be in [1, 1024]");
   const int every = s.sample_every(sample_interval);
@@ -111,7 +126,7 @@ PyResult plan_one(const Session& s, const py::object& start, const py::object& g
   SimulatorWorkspace ws(s.session->sim);
   const Query q = parse(s, ws, doc, "");
   RolloutPool pool(s.session->sim, sim_threads);
-  return answer(s, ws, pool, q, every);
+  return answer(s, ws, pool, q, every, raw);
 }
 
 // Ctrl-C during a batch: the calling thread (OpenMP's thread 0) looks for a pending signal
@@ -135,7 +150,7 @@ struct BatchInterrupt {
 // Every query parsed (checked) first, then planned on `jobs` threads; the first error a
 // planner throws is `failure`.
 std::vector<PyResult> plan_parsed(const Session& s, const std::vector<nlohmann::json>& docs,
-                                  int jobs, int every, BatchInterrupt& interrupt,
+                                  int jobs, int every, bool raw, BatchInterrupt& interrupt,
                                   std::exception_ptr& failure) {
   std::vector<Query> parsed;
   {
@@ -153,7 +168,7 @@ std::vector<PyResult> plan_parsed(const Session& s, const std::vector<nlohmann::
     for (long k = 0; k < static_cast<long>(parsed.size()); ++k) {
       if (interrupt.check()) continue;
       try {
-        results[k] = answer(s, ws, pool, parsed[k], every);
+        results[k] = answer(s, ws, pool, parsed[k], every, raw);
       } catch (...) {
         errors[k] = std::current_exception();
       }
@@ -165,7 +180,7 @@ std::vector<PyResult> plan_parsed(const Session& s, const std::vector<nlohmann::
 }
 
 std::vector<PyResult> plan_many(const Session& s, const py::iterable& queries, int jobs,
-                                double sample_interval) {
+                                double sample_interval, bool raw) {
   if (jobs < 0 || jobs > 1024) throw InputError("jobs: must be in [0, 1024]");
   if (jobs == 0) jobs = omp_get_num_procs();
   const int every = s.sample_every(sample_interval);
@@ -182,7 +197,7 @@ std::vector<PyResult> plan_many(const Session& s, const py::iterable& queries, i
   std::vector<PyResult> results;
   {
     py::gil_scoped_release free;
-    results = plan_parsed(s, docs, jobs, every, interrupt, failure);
+    results = plan_parsed(s, docs, jobs, every, raw, interrupt, failure);
   }
   if (interrupt.error) std::rethrow_exception(interrupt.error);
   if (failure) std::rethrow_exception(failure);
@@ -237,6 +252,13 @@ void bind_result(py::module_& m) {
       .def_readonly("t", &PyTrajectory::t, "Sample times, s, (T,).")
       .def_readonly("q", &PyTrajectory::q, "Joint positions, (T, dof).")
       .def_readonly("dq", &PyTrajectory::dq, "Joint velocities, (T, dof).")
+      .def_readonly("ddq", &PyTrajectory::ddq,
+                    "Joint accelerations over the control tick from each sample, (T, dof); "
+                    "(0, dof) for a raw chain (raw=True).")
+      .def_readonly("cmd", &PyTrajectory::cmd,
+                    "Commanded joint velocities, (T, dof); (0, dof) for a raw chain.")
+      .def_readonly("stops", &PyTrajectory::stops,
+                    "Stops at rest between the start and the end (a raw chain: steps - 1).")
       .def_readonly("edges", &PyTrajectory::edges,
                     "Bundle edge of each step (-1: not a bundle edge).")
       .def_readonly("cost", &PyTrajectory::cost, "Joint-space arc length, rad.")
@@ -302,7 +324,8 @@ void bind_result(py::module_& m) {
             return py::cast(
                 trajectory_of(r.trajectory, static_cast<int>(r.query.problem.start.size())));
           },
-          "The realized trajectory (t, q, dq, edges, cost, duration); None without a solution.")
+          "The trajectory (t, q, dq, ddq, cmd, edges, cost, duration, stops): the executable one, "
+          "or the raw chain with raw=True; None without a solution.")
       .def(
           "to_dict", [](const PyResult& r) { return from_json(r.json()); },
           "The result line of lazyboe-query --trajectories inline, as a dict.")
@@ -339,6 +362,7 @@ void bind_planning(py::module_& m) {
                    [&] { return std::make_shared<const PlanningSession>(p, memory_map, r, e); });
              }
              s.context = std::make_unique<const PlanningContext>(s.session->context());
+             s.execution.limits = s.context->command;
              return s;
            }),
            py::arg("bundle_path"), py::arg("memory_map") = true, py::arg("robot") = py::none(),
@@ -348,16 +372,18 @@ void bind_planning(py::module_& m) {
            "corrupt bundle or mismatching files.")
       .def("plan", &plan_one, py::arg("start"), py::arg("goal"), py::arg("planner") = "lazyboe",
            py::arg("budget") = py::none(), py::arg("seed") = py::none(), py::arg("id") = "",
-           py::arg("sample_interval") = 0.01, py::arg("sim_threads") = 1,
+           py::arg("sample_interval") = 0.01, py::arg("sim_threads") = 1, py::arg("raw") = false,
            "Plans one query, as a line of lazyboe-query would: start (dof values), goal "
            "({'q': [...], 'tolerance': 0.1} or {'position': [x, y, z], 'tolerance': 0.02, "
            "'link': name}), planner (lazyboe.planners()), budget (s, default 5), seed (default "
            "1), and the planner's parameters by name as keywords (stop_at_first=True, "
-           "theta=0.4, ...). sample_interval: trajectory sample spacing, s; sim_threads: "
-           "threads simulating one query's edges (the answer does not depend on it). ValueError "
+           "theta=0.4, ...). sample_interval: trajectory sample spacing, s (0.001: every control "
+           "tick); sim_threads: threads simulating one query's edges (the answer does not depend "
+           "on it); raw: the planner's edge chain with a stop at every junction (lazyboe-query "
+           "--raw) instead of the executable trajectory (blended, shortcut). ValueError "
            "(with the field's name) for a bad query; returns a PlanResult.")
       .def("plan_many", &plan_many, py::arg("queries"), py::arg("jobs") = 0,
-           py::arg("sample_interval") = 0.01,
+           py::arg("sample_interval") = 0.01, py::arg("raw") = false,
            "Plans a batch of queries (dicts in the query format: start, goal, planner, budget, "
            "seed, parameters; id optional) on `jobs` threads (0: all cores); results in input "
            "order. Every query is checked before any is planned. Ctrl-C stops the batch "

@@ -32,22 +32,37 @@ def query(q):
             "stop_at_first": True, **q}
 
 
-@pytest.fixture(scope="module")
-def tool_results(bundle_path, tmp_path_factory):
+def run_tool(bundle_path, tmp_path_factory, *options):
     queries = tmp_path_factory.mktemp("queries") / "q.jsonl"
     queries.write_text("".join(json.dumps(query(q)) + "\n" for q in QUERIES))
     out = tool("lazyboe-query", "--bundle", bundle_path, "--queries", queries,
-               "--trajectories", "inline", "--quiet").stdout
+               "--trajectories", "inline", "--quiet", *options).stdout
     return {r["id"]: r for r in map(json.loads, out.splitlines())}
 
 
+@pytest.fixture(scope="module")
+def tool_results(bundle_path, tmp_path_factory):
+    """lazyboe-query's default: executable (post-processed) trajectories."""
+    return run_tool(bundle_path, tmp_path_factory)
+
+
+@pytest.fixture(scope="module")
+def tool_raw_results(bundle_path, tmp_path_factory):
+    return run_tool(bundle_path, tmp_path_factory, "--raw")
+
+
+def without_timings(d):
+    """A result line without its wall times (and line number), which no two runs share."""
+    d.pop("time_to_first_solution")
+    d.pop("line", None)
+    for timing in ("seconds", "raw_seconds"):
+        d.get("post_processing", {}).pop(timing, None)
+    return d
+
+
 def same_as_tool(result, line):
-    """Every field of the result line but the timing and the line number."""
-    mine = result.to_dict()
-    for d in (mine, line):
-        d.pop("time_to_first_solution")
-        d.pop("line")
-    assert mine == line
+    """Every field of the result line but the timings and the line number."""
+    assert without_timings(result.to_dict()) == without_timings(line)
     assert result.success == line["success"]
     if result.success:
         assert result.best_cost == line["best_cost"]
@@ -55,6 +70,12 @@ def same_as_tool(result, line):
         assert result.trajectory.t.tolist() == line["trajectory"]["t"]
         assert result.trajectory.q.tolist() == line["trajectory"]["q"]
         assert result.trajectory.dq.tolist() == line["trajectory"]["dq"]
+        if "post_processing" in line:
+            assert result.trajectory.ddq.tolist() == line["trajectory"]["ddq"]
+            assert result.trajectory.cmd.tolist() == line["trajectory"]["cmd"]
+            assert result.trajectory.stops == line["stops"]
+        else:
+            assert result.trajectory.ddq.shape == (0, 7)
 
 
 def test_plan_equals_lazyboe_query(session, tool_results):
@@ -69,6 +90,24 @@ def test_plan_many_equals_lazyboe_query(session, tool_results):
     assert [r.id for r in results] == [q["id"] for q in QUERIES]
     for r in results:
         same_as_tool(r, dict(tool_results[r.id]))
+
+
+def test_raw_equals_lazyboe_query_raw(session, tool_raw_results):
+    for q in QUERIES:
+        r = session.plan(**query(q), raw=True)
+        assert r.success, r.failure
+        same_as_tool(r, dict(tool_raw_results[q["id"]]))
+    for r in session.plan_many([query(q) for q in QUERIES], jobs=2, raw=True):
+        same_as_tool(r, dict(tool_raw_results[r.id]))
+
+
+def test_executable_trajectory_is_shorter_to_run_than_the_raw_chain(session):
+    q = query(QUERIES[0])
+    executable, raw = session.plan(**q), session.plan(**q, raw=True)
+    assert executable.edges.tolist() == raw.edges.tolist()  # the same planner answer
+    assert executable.trajectory.stops < raw.trajectory.stops or raw.trajectory.stops == 0
+    assert executable.trajectory.duration <= raw.trajectory.duration
+    assert executable.to_dict()["raw_duration"] == pytest.approx(raw.trajectory.duration)
 
 
 def test_result_attributes(session):
@@ -164,8 +203,7 @@ def test_threads_plan_concurrently_with_the_same_results(session):
     for t in threads:
         t.join()
     for a, b in zip(sequential, concurrent):
-        a.pop("time_to_first_solution"), b.pop("time_to_first_solution")
-        assert a == b
+        assert without_timings(a) == without_timings(b)
 
 
 def test_planners_lists_the_registry():
