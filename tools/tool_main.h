@@ -79,6 +79,9 @@ inline bool stop_requested() { return detail::g_stop.load(); }
 
 template <typename Body>
 int run_tool(const char* tool, Body&& body) {
+  // Past a file-size limit (ulimit -f) a write fails with EFBIG and is reported like a full
+  // disk, instead of the signal ending the process.
+  std::signal(SIGXFSZ, SIG_IGN);
   try {
     return body();
   } catch (const CLI::ParseError&) {

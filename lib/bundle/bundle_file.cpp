@@ -208,6 +208,15 @@ void write_perturbation(const std::string& tmp, hid_t file, const Perturbation& 
   }
 }
 
+// The dataset bytes of the file, to size its memory image at once.
+uint64_t payload_bytes(const Bundle& b) {
+  const Perturbation& p = b.perturbation;
+  return 8 * (b.q0.size() + b.qf.size() + b.duration.size() + b.command_duration.size() +
+              b.attempt.size() + b.knot_offset.size() + b.sample_offset.size() + b.knots.size()) +
+         4 * (b.sample_q.size() + b.sample_dq.size()) +
+         (p.present ? 8 * b.size() * (p.has_transfer ? 10 : 7) : 0);
+}
+
 }  // namespace
 
 void check_bundle(const Bundle& b, const std::string& where) {
@@ -256,14 +265,15 @@ void check_bundle(const Bundle& b, const std::string& where) {
 void write_bundle(const std::string& path, const Bundle& b) {
   check_bundle(b, path);
   AtomicFile out(path, AtomicFile::Writer::External);
-  const std::string& tmp = out.temp_path();
-  {
-    h5::File file = h5::create_file(tmp);
-    write_header(tmp, file, b.header, b.size());
-    write_edges(tmp, file, b);
-    if (b.perturbation.present) write_perturbation(tmp, file, b.perturbation, b.size());
-    h5::close_file(tmp, file);
-  }
+  // The file is composed in memory and written with plain writes, so that a full disk is one
+  // clear error naming `path` (HDF5 itself, failing a write, leaves a state that crashes at exit).
+  h5::File file = h5::create_memory_file(path, payload_bytes(b) + (1 << 20));
+  write_header(path, file, b.header, b.size());
+  write_edges(path, file, b);
+  if (b.perturbation.present) write_perturbation(path, file, b.perturbation, b.size());
+  const std::vector<unsigned char> image = h5::memory_file_image(path, file);
+  file.close();
+  out.write_all(image.data(), image.size());
   out.commit();
 }
 
