@@ -91,5 +91,56 @@ TEST(FullDisk, PerturbPastTheLimitKeepsTheBundle) {
   EXPECT_EQ(files_in(dir), std::vector<std::string>{"b.h5"});
 }
 
+// ---- an output is never an input --------------------------------------------------------
+
+TEST(OutputIsNotAnInput, QueryRefusesToWriteOverItsBundleOrQueries) {
+  const std::string dir = fresh_dir("out-query");
+  const std::string bundle = copy_of_small_bundle(dir);
+  const std::string queries = dir + "/q.jsonl";
+  write_bytes(queries, "\n");
+  fs::create_symlink(bundle, dir + "/link.h5");
+  const auto before = snapshot(dir);
+  for (const std::string& out : {bundle, dir + "/link.h5", dir + "/./bundle.h5"}) {
+    const CommandResult r =
+        tool("lazyboe-query", {"--bundle", bundle, "--queries", queries, "--out", out});
+    expect_one_line_error(r, {"--out " + out, "--bundle " + bundle, "never replaces an input"});
+  }
+  const CommandResult r =
+      tool("lazyboe-query", {"--bundle", bundle, "--queries", queries, "--out", queries});
+  expect_one_line_error(r, {"--out " + queries, "--queries", "never replaces an input"});
+  EXPECT_EQ(snapshot(dir), before);
+}
+
+TEST(OutputIsNotAnInput, RobotToolRefusesToWriteOverItsCsv) {
+  const std::string dir = fresh_dir("out-robot");
+  write_bytes(dir + "/x.csv",
+              "q1,q2,q3,q4,q5,q6,q7,dq1,dq2,dq3,dq4,dq5,dq6,dq7,ddq1,ddq2,ddq3,ddq4,ddq5,ddq6,"
+              "ddq7\n0,0,0,-1.5,0,1.5,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0\n");
+  write_bytes(dir + "/c.csv", "q1,q2,q3,q4,q5,q6,q7\n0,0,0,-1.5,0,1.5,0\n");
+  const auto before = snapshot(dir);
+  expect_one_line_error(
+      tool("lazyboe-robot", {"torques", "--in", dir + "/x.csv", "--out", dir + "/x.csv"}),
+      {"--out", "--in", "never replaces an input"});
+  expect_one_line_error(
+      tool("lazyboe-robot", {"check", "--in", "c.csv", "--out", "./c.csv"}, 0, dir),
+      {"--out ./c.csv", "--in c.csv", "never replaces an input"});
+  EXPECT_EQ(snapshot(dir), before);
+  // A different output is fine.
+  const CommandResult ok =
+      tool("lazyboe-robot", {"check", "--in", "c.csv", "--out", "r.csv"}, 0, dir);
+  EXPECT_EQ(ok.exit_code, 0) << describe(ok);
+}
+
+TEST(OutputIsNotAnInput, BuildRefusesToWriteOverItsEnvironmentEvenWithForce) {
+  const std::string dir = fresh_dir("out-build");
+  const std::string env = dir + "/env.json";
+  fs::copy_file(source_path("data/environments/table.json"), env);
+  const auto before = snapshot(dir);
+  expect_one_line_error(
+      tool("lazyboe-build", {"--edges", "5", "--env", env, "--out", env, "--force", "--quiet"}),
+      {"--out " + env, "--env", "never replaces an input"});
+  EXPECT_EQ(snapshot(dir), before);
+}
+
 }  // namespace
 }  // namespace lazyboe::test

@@ -9,6 +9,7 @@
 #include "lazyboe/bundle/builder.h"
 #include "lazyboe/bundle/bundle_file.h"
 #include "lazyboe/bundle/inspect.h"
+#include "lazyboe/common/file_checks.h"
 #include "lazyboe/common/json_fields.h"
 #include "lazyboe/common/version.h"
 #include "tool_main.h"
@@ -250,6 +251,10 @@ int run(const CLI::App& app, BuildOptions& o) {
 
   const RobotModel robot = load_robot(o.robot_path);
   const Environment env = load_environment(o.env_path);
+  refuse_output_as_input({"--out", o.out_path}, {{"--robot", o.robot_path},
+                                                 {"URDF", robot.urdf_path},
+                                                 {"--env", o.env_path},
+                                                 {"--region", o.region}});
   const CollisionModel collision = build_collision_model(robot, env);
   s.simulation.sample_every =
       exact_sample_every_ticks(o.sample_interval, robot.control_rate, "--sample-interval");

@@ -12,6 +12,7 @@
 #include <memory>
 
 #include "lazyboe/common/atomic_file.h"
+#include "lazyboe/common/file_checks.h"
 #include "lazyboe/common/histogram.h"
 #include "lazyboe/io/query_io.h"
 #include "lazyboe/planning/planning_session.h"
@@ -236,6 +237,11 @@ int run(const Options& o) {
   if (o.sim_threads > 1024)
     fail("--sim-threads", "at most 1024, got " + std::to_string(o.sim_threads));
   const PlanningSession session(o.bundle_path, !o.no_mmap, o.robot_path, o.env_path);
+  refuse_output_as_input({"--out", o.out_path}, {{"--bundle", o.bundle_path},
+                                                 {"--queries", o.queries_path},
+                                                 {"robot config", session.scene.robot.config_path},
+                                                 {"URDF", session.scene.robot.urdf_path},
+                                                 {"environment", session.scene.env.path}});
   report_load(o, session);
   Job job{session, session.context(), QueryDefaults{}, 1, mode, o.trajectory_dir};
   job.sample_every =

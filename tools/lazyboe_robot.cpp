@@ -8,6 +8,7 @@
 
 #include "lazyboe/collision/allowed_pairs.h"
 #include "lazyboe/collision/collision_model.h"
+#include "lazyboe/common/file_checks.h"
 #include "lazyboe/io/csv.h"
 #include "lazyboe/robot/dynamics.h"
 #include "tool_main.h"
@@ -279,6 +280,13 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
   return lazyboe::run_tool("lazyboe-robot", [&]() {
     const lazyboe::RobotModel robot = lazyboe::load_robot(robot_path);
+    if (*torques || *check) {
+      lazyboe::refuse_output_as_input({"--out", out_path},
+                                      {{"--in", in_path},
+                                       {"--robot", robot_path},
+                                       {"URDF", robot.urdf_path},
+                                       {"--env", *check ? env_path : std::string()}});
+    }
     if (*info) return cmd_info(robot, info_json);
     if (*fk) return cmd_fk(robot, q_text, link_name);
     if (*torques) return cmd_torques(robot, in_path, out_path);
