@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include <filesystem>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -140,6 +141,154 @@ TEST(OutputIsNotAnInput, BuildRefusesToWriteOverItsEnvironmentEvenWithForce) {
       tool("lazyboe-build", {"--edges", "5", "--env", env, "--out", env, "--force", "--quiet"}),
       {"--out " + env, "--env", "never replaces an input"});
   EXPECT_EQ(snapshot(dir), before);
+}
+
+// ---- numbers are parsed strictly and range-checked --------------------------------------
+
+// A copy of the bundled Panda (config and URDF) in `dir`, with `edit` applied to the URDF text
+// (first occurrence of `from` replaced by `to`); returns the config path.
+std::string panda_with(const std::string& dir, const std::string& file, const std::string& from,
+                       const std::string& to) {
+  fs::copy_file(source_path("data/robots/panda.json"), dir + "/panda.json");
+  fs::copy_file(source_path("data/robots/panda.urdf"), dir + "/panda.urdf");
+  std::string text = read_file(dir + "/" + file);
+  const size_t at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  if (at != std::string::npos) text.replace(at, from.size(), to);
+  write_bytes(dir + "/" + file, text);
+  return dir + "/panda.json";
+}
+
+struct TextCase {
+  std::string file, from, to;
+  std::vector<std::string> needles;
+};
+
+TEST(StrictNumbers, UrdfValuesAreReadStrictlyNamingTheLinkOrJoint) {
+  const std::vector<TextCase> cases = {
+      {"panda.urdf",
+       R"(<mass value="0.629769"/>)",
+       R"(<mass value="abc"/>)",
+       {"panda.urdf:27: link 'panda_link0' <mass value>", "'abc'", "[0, 100000] kg"}},
+      {"panda.urdf",
+       R"(<mass value="0.629769"/>)",
+       R"(<mass value="4.97abc"/>)",
+       {"link 'panda_link0' <mass value>", "'4.97abc'"}},
+      {"panda.urdf",
+       R"(ixx=")",
+       R"(ixx="0.7x" ixx_was=")",
+       {"link 'panda_link0' <inertia ixx>", "'0.7x'"}},
+      {"panda.urdf",
+       R"(<mass value="0.629769"/>)",
+       R"(<mass value="1e308"/>)",
+       {"link 'panda_link0' <mass value>", "1e+308", "outside", "[0, 100000] kg"}},
+      {"panda.urdf",
+       R"(effort=")",
+       R"(effort="nan" was=")",
+       {"joint 'panda_joint1' <limit effort>", "'nan'"}},
+      {"panda.urdf",
+       R"(<joint name="panda_joint1" type="revolute">)",
+       R"(<joint name="panda_joint1" type="spherical">)",
+       {"joint 'panda_joint1'", "unknown joint type 'spherical'"}},
+      {"panda.urdf", R"(<limit )", R"(<limits )", {"joint 'panda_joint1'", "missing <limit>"}},
+      {"panda.urdf",
+       R"(<origin xyz="-0.041018 -0.00014 0.049974")",
+       R"(<origin xyz="-0.041018 -0.00014")",
+       {"link 'panda_link0' <origin xyz>", "expected 3 numbers"}},
+      {"panda.json",
+       R"("control_rate": )",
+       R"("control_rate": 1e400, "x": )",
+       {"panda.json:", "number out of range ('1e400')"}},
+      {"panda.json",
+       R"("margin": 0.)",
+       R"("margin": 5.)",
+       {"panda.json: collision.margin", "[0, 1] m"}},
+  };
+  for (size_t k = 0; k < cases.size(); ++k) {
+    SCOPED_TRACE(cases[k].to);
+    const std::string dir = fresh_dir("urdf-" + std::to_string(k));
+    const std::string config = panda_with(dir, cases[k].file, cases[k].from, cases[k].to);
+    expect_one_line_error(tool("lazyboe-robot", {"info", "--robot", config}), cases[k].needles);
+  }
+}
+
+TEST(StrictNumbers, EnvironmentSizesAreRangeChecked) {
+  const std::string dir = fresh_dir("env-range");
+  std::string env = read_file(source_path("data/environments/table.json"));
+  env.replace(env.find("[0.6, 1.2, 0.04]"), 16, "[1e308, 1.2, 0.04]");
+  write_bytes(dir + "/env.json", env);
+  write_bytes(dir + "/q.csv", "q1,q2,q3,q4,q5,q6,q7\n0,0,0,-1.5,0,1.5,0\n");
+  expect_one_line_error(
+      tool("lazyboe-robot", {"check", "--env", "env.json", "--in", "q.csv", "--out", "r.csv"}, 0,
+           dir),
+      {"env.json: objects[1].size", "1e+308", "(0, 100] m"});
+}
+
+TEST(StrictNumbers, CsvCellsAndCommandLineNumbersAreDecimalOnly) {
+  const std::string dir = fresh_dir("csv-hex");
+  write_bytes(dir + "/q.csv", "q1,q2,q3,q4,q5,q6,q7\n0,0,0,-1.5,0,1.5,0\n0x10,0,0,-1.5,0,1.5,0\n");
+  expect_one_line_error(tool("lazyboe-robot", {"check", "--in", "q.csv", "--out", "r.csv"}, 0, dir),
+                        {"q.csv:3: column 'q1'", "'0x10'"});
+  EXPECT_FALSE(fs::exists(dir + "/r.csv"));
+  expect_one_line_error(tool("lazyboe-robot", {"fk", "--q", "0x1,0,0,-1.5,0,1.5,0"}),
+                        {"--q", "'0x1'"});
+  for (const char* budget : {"nan", "inf", "0x10", "1e7", "-1", "5s"}) {
+    const CommandResult r = tool(
+        "lazyboe-bench", {"--bundle", small_bundle(), "--out", dir + "/study", "--budget", budget});
+    EXPECT_GE(r.exit_code, 2) << describe(r);
+    expect_one_line_error(r, {"--budget", "(0, 1000000] s"});
+  }
+  EXPECT_FALSE(fs::exists(dir + "/study"));
+}
+
+TEST(StrictNumbers, QueryBudgetBeyondTheClockIsAnErrorLine) {
+  const std::string dir = fresh_dir("budget");
+  write_bytes(
+      dir + "/q.jsonl",
+      R"({"id": "a", "planner": "boe", "budget": 9.3e9, "start": [0, 0, 0, -1.5, 0, 1.5, 0], "goal": {"q": [0.3, 0, 0, -1.5, 0, 1.5, 0]}})"
+      "\n"
+      R"({"id": "b", "planner": "boe", "budget": 1, "budget": 2, "start": [0, 0, 0, -1.5, 0, 1.5, 0], "goal": {"q": [0.3, 0, 0, -1.5, 0, 1.5, 0]}})"
+      "\n");
+  const CommandResult r =
+      tool("lazyboe-query", {"--bundle", small_bundle(), "--queries", dir + "/q.jsonl", "--quiet"});
+  ASSERT_EQ(r.exit_code, 0) << describe(r);
+  std::istringstream lines(r.out);
+  std::string a, b;
+  std::getline(lines, a);
+  std::getline(lines, b);
+  EXPECT_TRUE(contains(a, "line 1: budget") && contains(a, "(0, 1000000] s")) << a;
+  EXPECT_TRUE(contains(b, "line 2") && contains(b, "duplicate key 'budget'")) << b;
+}
+
+// ---- a directory is not a file ------------------------------------------------------------
+
+TEST(DirectoryAsFile, EveryToolNamesItAsADirectory) {
+  const std::string dir = fresh_dir("dir-as-file");
+  fs::create_directory(dir + "/d");
+  const std::string d = dir + "/d";
+  expect_one_line_error(tool("lazyboe-query", {"--bundle", small_bundle(), "--queries", d, "--out",
+                                               dir + "/r.jsonl", "--quiet"}),
+                        {d, "is a directory"});
+  EXPECT_FALSE(fs::exists(dir + "/r.jsonl"));
+  expect_one_line_error(tool("lazyboe-robot", {"info", "--robot", d}), {d, "is a directory"});
+  expect_one_line_error(
+      tool("lazyboe-robot", {"check", "--env", d, "--in", d, "--out", dir + "/x"}),
+      {d, "is a directory"});
+  expect_one_line_error(tool("lazyboe-robot", {"check", "--in", d, "--out", dir + "/x"}),
+                        {d, "is a directory"});
+  expect_one_line_error(tool("lazyboe-build", {"--inspect", d}), {d, "is a directory"});
+  const std::string cfg =
+      panda_with(dir, "panda.json", R"("urdf": "panda.urdf")", R"("urdf": "d")");
+  expect_one_line_error(tool("lazyboe-robot", {"info", "--robot", cfg}),
+                        {dir + "/d", "URDF file", "is a directory"});
+}
+
+// The tool-wide options of lazyboe-robot go anywhere on the line.
+TEST(RobotTool, ToolWideOptionsAfterTheSubcommand) {
+  const CommandResult r =
+      tool("lazyboe-robot", {"info", "--json", "--robot", source_path("data/robots/panda.json")});
+  EXPECT_EQ(r.exit_code, 0) << describe(r);
+  EXPECT_TRUE(contains(r.out, "\"name\": \"panda\"")) << r.out;
 }
 
 }  // namespace

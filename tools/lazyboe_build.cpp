@@ -104,26 +104,34 @@ void add_options(CLI::App& app, BuildOptions& o) {
          "--region", o.region,
          "Start-state box: default (robot config), limits, a JSON file, or lo:hi,... per joint")
       ->capture_default_str();
+  const RealRange seconds{0, 1e3, true}, fraction{0, 1, true};
   app.add_option("--min-duration", s.command.min_duration, "Shortest velocity command, s")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(real_in(seconds, " s"));
   app.add_option("--max-duration", s.command.max_duration, "Longest velocity command, s")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(real_in(seconds, " s"));
   app.add_option("--knot-interval", s.command.knot_interval, "Nominal spacing of velocity knots, s")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(real_in(seconds, " s"));
   app.add_option("--velocity-scale", s.command.velocity_scale,
                  "Knot speeds up to this fraction of the velocity limits")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(real_in(fraction));
   app.add_option("--limit-scale", s.command.limit_scale,
                  "Commanded acceleration and jerk up to this fraction of the limits")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(real_in(fraction));
   app.add_option("--integrator", o.integrator, "euler (semi-implicit) or rk4")
       ->capture_default_str();
   app.add_option("--substeps", s.simulation.substeps, "Integration steps per control period")
       ->capture_default_str();
   app.add_option("--sample-interval", o.sample_interval, "Stored trajectory spacing, s (0: none)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(real_in({0, 1e3}, " s"));
   app.add_option("--theta", s.design_theta, "Neighbourhood radius the bundle is designed for (rad)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(real_in({0, 1e3, true}, " rad"));
   app.add_option("--checkpoint-seconds", o.control.checkpoint_seconds,
                  "Least time between checkpoints")
       ->capture_default_str()

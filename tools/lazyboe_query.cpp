@@ -78,7 +78,8 @@ void add_options(CLI::App& app, Options& o) {
       ->capture_default_str();
   app.add_option("--trajectory-dir", o.trajectory_dir, "Directory for --trajectories csv");
   app.add_option("--sample-interval", o.sample_interval, "Trajectory sample spacing, s")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(real_in({0, 1e3, true}, " s"));
   app.add_option("--robot", o.robot_path, "Robot config (default: the bundle's)");
   app.add_option("--env", o.env_path, "Environment (default: the bundle's)");
   app.add_flag("--no-mmap", o.no_mmap, "Read the bundle into memory instead of mapping it");
@@ -168,6 +169,7 @@ std::vector<Outcome> answer_stream(const Job& job, std::ostream& out, int sim_th
 // A file: `jobs` queries at a time, results in input order.
 std::vector<Outcome> answer_file(const Job& job, const std::string& path, std::ostream& out,
                                  int jobs, int sim_threads) {
+  require_input_file(path, "--queries");
   std::ifstream in(path);
   if (!in) fail(path, "cannot open file");
   std::vector<std::pair<int, std::string>> lines;

@@ -25,12 +25,7 @@ JointVector parse_q(const std::string& text, const RobotModel& robot) {
     const size_t comma = std::min(text.find(',', start), text.size());
     const std::string cell = text.substr(start, comma - start);
     start = comma + 1;
-    char* end = nullptr;
-    const double v = std::strtod(cell.c_str(), &end);
-    if (cell.empty() || end == cell.c_str() || *end != '\0')
-      fail("--q", "not a number: '" + cell + "'");
-    if (!std::isfinite(v)) fail("--q", "values must be finite");
-    values.push_back(v);
+    values.push_back(parse_real_in(cell, {-1e3, 1e3}, "--q", " rad or m"));
   }
   if (static_cast<int>(values.size()) != robot.dof) {
     fail("--q", "expected " + std::to_string(robot.dof) + " comma-separated joint values, got " +
@@ -178,7 +173,7 @@ int cmd_torques(const RobotModel& robot, const std::string& in, const std::strin
   for (const char* p : {"dq", "ddq"}) {
     for (const std::string& c : numbered_columns(p, n)) header.push_back(c);
   }
-  const CsvTable table = read_numeric_csv(in, header);
+  const CsvTable table = read_numeric_csv(in, header, {-1e6, 1e6});  // rad, rad/s, rad/s^2
   RobotData data(robot);
   CsvWriter writer(out, numbered_columns("tau", n));
   std::vector<double> row(n);
@@ -198,7 +193,7 @@ int cmd_check(const RobotModel& robot, const std::string& env_path, const std::s
               const std::string& out) {
   const Environment env = load_environment(env_path);
   const CollisionModel cm = build_collision_model(robot, env);
-  const CsvTable table = read_numeric_csv(in, numbered_columns("q", robot.dof));
+  const CsvTable table = read_numeric_csv(in, numbered_columns("q", robot.dof), {-1e3, 1e3});
   RobotData rd(robot);
   CollisionData cd(cm);
   CsvWriter writer(out, {"in_limits", "self_collision", "env_collision", "min_distance"});
@@ -242,6 +237,8 @@ int cmd_allowed_pairs(const RobotModel& robot, long samples, uint64_t seed) {
 int main(int argc, char** argv) {
   CLI::App app{"Inspect a robot description: joints, kinematics, dynamics, collision."};
   app.require_subcommand(1);
+  // Tool-wide options (--robot) are accepted after the subcommand too, as users type them.
+  app.fallthrough();
   std::string robot_path = lazyboe::default_robot_path();
   app.add_option("--robot", robot_path, "Robot config (JSON) naming its URDF")
       ->capture_default_str();

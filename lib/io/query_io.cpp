@@ -4,6 +4,7 @@
 
 #include "lazyboe/common/error.h"
 #include "lazyboe/common/json_fields.h"
+#include "lazyboe/common/numbers.h"
 #include "lazyboe/io/csv.h"
 
 namespace lazyboe {
@@ -101,12 +102,7 @@ const std::vector<std::string>& query_fields() {
 Query parse_query(const std::string& text, int line, const RobotModel& robot, const Simulator& sim,
                   SimulatorWorkspace& ws, const QueryDefaults& d, std::string& id_out) {
   const std::string where = "line " + std::to_string(line);
-  nlohmann::json doc;
-  try {
-    doc = nlohmann::json::parse(text);
-  } catch (const nlohmann::json::parse_error&) {
-    fail(where, "not valid JSON");
-  }
+  const nlohmann::json doc = parse_json_text(text, where, false);
   if (!doc.is_object()) fail(where, "expected a JSON object");
   if (doc.contains("id") && doc["id"].is_string()) id_out = doc["id"].get<std::string>();
   const JsonField root(doc, where, "");
@@ -116,7 +112,9 @@ Query parse_query(const std::string& text, int line, const RobotModel& robot, co
   q.id = root.at("id").string();
   parse_planner(root, q);
   PlanningProblem& p = q.problem;
-  p.termination.budget = root.has("budget") ? root.at("budget").positive() : d.budget;
+  p.termination.budget = root.has("budget")
+                             ? root.at("budget").number_in({0, kMaxBudgetSeconds, true}, " s")
+                             : d.budget;
   if (root.has("stop_at_first")) p.termination.stop_at_first = root.at("stop_at_first").boolean();
   p.seed = root.has("seed") ? static_cast<uint64_t>(root.at("seed").integer()) : 1;
   if (root.has("seed") && root.at("seed").integer() < 0) root.at("seed").fail("must be >= 0");

@@ -55,7 +55,8 @@ ProblemIssue find_problem_issue(const Simulator& sim, SimulatorWorkspace& ws,
   }
   if (!(g.tolerance > 0)) return {"goal.tolerance", "must be > 0"};
   if (g.contains(robot, ws.robot, p.start)) return {"goal", "the start already satisfies the goal"};
-  if (!(p.termination.budget > 0)) return {"budget", "must be > 0"};
+  if (!(p.termination.budget > 0 && p.termination.budget <= kMaxBudgetSeconds))
+    return {"budget", "must be in (0, 1000000] s"};
   return {};
 }
 
@@ -85,8 +86,7 @@ Trajectory realize_path(const Simulator& sim, SimulatorWorkspace& ws, const Join
     const size_t rows = sq.size() / n;
     for (size_t i = (k == 0 ? 0 : 1); i < rows; ++i) {  // a step starts where the last ended
       const bool last = i + 1 == rows;
-      traj.t.push_back(t0 +
-                       (last ? r.duration : static_cast<double>(i * sample_every) * sim.dt));
+      traj.t.push_back(t0 + (last ? r.duration : static_cast<double>(i * sample_every) * sim.dt));
       // The start and each step's end are exact; samples in between are stored as float32
       // by the simulator (to about 1e-7 rad).
       JointVector qi(n), dqi(n);
