@@ -7,7 +7,10 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <functional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -289,6 +292,73 @@ TEST(RobotTool, ToolWideOptionsAfterTheSubcommand) {
       tool("lazyboe-robot", {"info", "--json", "--robot", source_path("data/robots/panda.json")});
   EXPECT_EQ(r.exit_code, 0) << describe(r);
   EXPECT_TRUE(contains(r.out, "\"name\": \"panda\"")) << r.out;
+}
+
+// ---- one bundle validation, run by every tool on open ------------------------------------
+
+// Overwrites element `index` of a contiguous dataset of doubles or uint64 in place (the bytes
+// HDF5 reports for it), as a damaged or hand-edited file would have it.
+template <typename T>
+void poke(const std::string& path, const std::string& dataset, uint64_t index, T value) {
+  const DatasetLocation loc = dataset_location(path, dataset);
+  ASSERT_TRUE(loc.contiguous && loc.bytes >= (index + 1) * sizeof(T)) << dataset;
+  std::fstream f(path, std::ios::in | std::ios::out | std::ios::binary);
+  f.seekp(static_cast<std::streamoff>(loc.file_offset + index * sizeof(T)));
+  f.write(reinterpret_cast<const char*>(&value), sizeof(T));
+  ASSERT_TRUE(f.good());
+}
+
+struct Damage {
+  std::string name;
+  std::function<void(const std::string&)> apply;
+  std::vector<std::string> needles;
+};
+
+TEST(BundleValidation, EveryToolRefusesTheSameDamageNamingTheDataset) {
+  const double nan = std::nan("");
+  const std::vector<Damage> damages = {
+      {"nan in q0",
+       [&](const std::string& p) { poke<double>(p, "/edges/q0", 17, nan); },
+       {"/edges/q0", "edge 2 joint 4", "nan"}},
+      {"1e308 in q0",
+       [](const std::string& p) { poke<double>(p, "/edges/q0", 3, 1e308); },
+       {"/edges/q0", "edge 0 joint 4", "1e+308"}},
+      {"nan in p_lazy_prop",
+       [&](const std::string& p) { poke<double>(p, "/perturbation/p_lazy_prop", 5, nan); },
+       {"/perturbation/p_lazy_prop", "edge 5", "[0, 1]"}},
+      {"probability 2",
+       [](const std::string& p) { poke<double>(p, "/perturbation/p_collision", 9, 2.0); },
+       {"/perturbation/p_collision", "edge 9"}},
+      {"sample_offset out of range",
+       [](const std::string& p) { poke<uint64_t>(p, "/edges/sample_offset", 300, 1u << 30); },
+       {"/edges/sample_offset", "last value"}},
+      {"negative duration",
+       [](const std::string& p) { poke<double>(p, "/edges/duration", 0, -1.0); },
+       {"/edges/duration", "edge 0"}},
+  };
+  const std::string dir = fresh_dir("damage");
+  write_bytes(dir + "/q.jsonl", "\n");
+  for (size_t k = 0; k < damages.size(); ++k) {
+    SCOPED_TRACE(damages[k].name);
+    const std::string p = dir + "/b" + std::to_string(k) + ".h5";
+    fs::copy_file(small_bundle(), p);
+    damages[k].apply(p);
+    const std::string before = read_file(p);
+    std::vector<std::string> needles = damages[k].needles;
+    needles.insert(needles.begin(), p);
+    expect_one_line_error(tool("lazyboe-build", {"--inspect", p}), needles);
+    expect_one_line_error(tool("lazyboe-perturb", {"--bundle", p, "--quiet"}), needles);
+    expect_one_line_error(
+        tool("lazyboe-query", {"--bundle", p, "--queries", dir + "/q.jsonl", "--quiet"}), needles);
+    expect_one_line_error(tool("lazyboe-query", {"--bundle", p, "--queries", dir + "/q.jsonl",
+                                                 "--no-mmap", "--quiet"}),
+                          needles);
+    expect_one_line_error(
+        tool("lazyboe-bench", {"--bundle", p, "--out", dir + "/study" + std::to_string(k),
+                               "--problems", "1", "--quiet", "--no-figures"}),
+        needles);
+    EXPECT_EQ(read_file(p), before);
+  }
 }
 
 }  // namespace

@@ -1,5 +1,8 @@
 #include "lazyboe/bundle/bundle_file.h"
 
+#include <cmath>
+
+#include "lazyboe/bundle/bundle_check.h"
 #include "lazyboe/bundle/hdf5_handle.h"
 #include "lazyboe/common/atomic_file.h"
 #include "lazyboe/common/error.h"
@@ -44,6 +47,31 @@ void check_size(const std::string& where, const std::string& field, size_t found
   if (found != expected)
     fail(where, "bundle." + field + ": " + str(found) + " values, expected " + expected_text +
                     " = " + str(expected));
+}
+
+// Real attributes: finite and non-negative (an empty bundle written from default settings has
+// zeros; the tools that use a setting check it against what they need).
+void check_header_values(const std::string& where, const BundleHeader& h) {
+  const std::pair<const char*, double> values[] = {{"min_duration", h.min_duration},
+                                                   {"max_duration", h.max_duration},
+                                                   {"knot_interval", h.knot_interval},
+                                                   {"velocity_scale", h.velocity_scale},
+                                                   {"limit_scale", h.limit_scale},
+                                                   {"control_rate", h.control_rate},
+                                                   {"sample_interval", h.sample_interval},
+                                                   {"design_theta", h.design_theta},
+                                                   {"simulated_seconds", h.simulated_seconds},
+                                                   {"wall_seconds", h.wall_seconds}};
+  for (const auto& [name, v] : values)
+    if (!(std::isfinite(v) && v >= 0))
+      fail(where, std::string("attribute ") + name + ": " + std::to_string(v) +
+                      ", expected a finite number >= 0");
+  for (const auto* bounds : {&h.region_lower, &h.region_upper})
+    for (double v : *bounds)
+      if (!(std::abs(v) <= 1e3))
+        fail(where, std::string("attribute ") +
+                        (bounds == &h.region_lower ? "region_lower" : "region_upper") + ": " +
+                        std::to_string(v) + " is outside [-1000, 1000]");
 }
 
 // ---- header <-> root attributes ----
@@ -144,6 +172,7 @@ BundleHeader read_header(const std::string& where, hid_t file, uint64_t* edges) 
   const uint64_t n = read_attr_u64(where, file, "edges");
   if (edges) *edges = n;
   check_header(where, "attribute ", h);
+  check_header_values(where, h);
   return h;
 }
 
@@ -215,6 +244,39 @@ uint64_t payload_bytes(const Bundle& b) {
               b.attempt.size() + b.knot_offset.size() + b.sample_offset.size() + b.knots.size()) +
          4 * (b.sample_q.size() + b.sample_dq.size()) +
          (p.present ? 8 * b.size() * (p.has_transfer ? 10 : 7) : 0);
+}
+
+BundleArrays arrays_of(const Bundle& b, uint64_t knot_rows, uint64_t sample_rows) {
+  BundleArrays a;
+  a.edges = b.size();
+  a.dof = static_cast<uint64_t>(b.dof());
+  a.knot_rows = knot_rows;
+  a.sample_rows = sample_rows;
+  a.q0 = b.q0.data();
+  a.qf = b.qf.data();
+  a.duration = b.duration.data();
+  a.command_duration = b.command_duration.data();
+  a.knot_offset = b.knot_offset.data();
+  a.sample_offset = b.sample_offset.data();
+  a.knots = b.knots.data();
+  a.sample_q = b.sample_q.data();
+  a.sample_dq = b.sample_dq.data();
+  const Perturbation& p = b.perturbation;
+  if (!p.present) return a;
+  a.perturbations = p.perturbations;
+  a.done = p.done.data();
+  a.valid = p.valid.data();
+  a.lazy = p.lazy.data();
+  a.collision = p.collision.data();
+  a.max_error = p.max_error.data();
+  a.p_lazy_prop = p.p_lazy_prop.data();
+  a.p_collision = p.p_collision.data();
+  if (p.has_transfer) {
+    a.transfer_lazy = p.transfer_lazy.data();
+    a.transfer_max_error = p.transfer_max_error.data();
+    a.p_lazy_prop_transfer = p.p_lazy_prop_transfer.data();
+  }
+  return a;
 }
 
 }  // namespace
@@ -347,6 +409,7 @@ Bundle read_bundle(const std::string& path) {
       p.p_lazy_prop_transfer = h5::read_dataset<double>(path, file, ds::p_lazy_prop_transfer, {n});
     }
   }
+  check_bundle_arrays(arrays_of(b, k, s), path);
   return b;
 }
 
