@@ -361,5 +361,37 @@ TEST(BundleValidation, EveryToolRefusesTheSameDamageNamingTheDataset) {
   }
 }
 
+// ---- messages -----------------------------------------------------------------------------
+
+TEST(Messages, UnwritableOutputNamesTheOutputWithoutHdf5Text) {
+  const std::string dir = fresh_dir("unwritable");
+  const std::string out = dir + "/missing-dir/b.h5";
+  const CommandResult r = tool("lazyboe-build", {"--edges", "5", "--out", out, "--quiet"});
+  expect_one_line_error(r, {out + ": cannot write: No such file or directory"});
+  EXPECT_FALSE(contains(r.err, "HDF5")) << r.err;
+  EXPECT_FALSE(contains(r.err, ".tmp.")) << r.err;
+}
+
+TEST(Messages, MovedRobotConfigSaysWhereThePathCameFrom) {
+  const std::string dir = fresh_dir("moved");
+  fs::create_directory(dir + "/robot");
+  fs::copy_file(source_path("data/robots/panda.json"), dir + "/robot/panda.json");
+  fs::copy_file(source_path("data/robots/panda.urdf"), dir + "/robot/panda.urdf");
+  ASSERT_EQ(
+      tool("lazyboe-build",
+           {"--edges", "5", "--robot", "robot/panda.json", "--out", "b.h5", "--quiet"}, 0, dir)
+          .exit_code,
+      0);
+  fs::rename(dir + "/robot", dir + "/moved");
+  write_bytes(dir + "/q.jsonl", "\n");
+  expect_one_line_error(tool("lazyboe-query", {"--bundle", "b.h5", "--queries", "q.jsonl"}, 0, dir),
+                        {"robot/panda.json", "recorded in the bundle", "--robot"});
+  const CommandResult ok =
+      tool("lazyboe-query",
+           {"--bundle", "b.h5", "--queries", "q.jsonl", "--robot", "moved/panda.json", "--quiet"},
+           0, dir);
+  EXPECT_EQ(ok.exit_code, 0) << describe(ok);
+}
+
 }  // namespace
 }  // namespace lazyboe::test
