@@ -393,5 +393,24 @@ TEST(Messages, MovedRobotConfigSaysWhereThePathCameFrom) {
   EXPECT_EQ(ok.exit_code, 0) << describe(ok);
 }
 
+// ---- interruption ---------------------------------------------------------------------------
+
+// SIGTERM in the middle of `check` (100000 rows take seconds) leaves neither the output nor its
+// temporary file.
+TEST(Interruption, RobotCheckStoppedBySigtermLeavesNothing) {
+  const std::string dir = fresh_dir("check-term");
+  std::string csv = "q1,q2,q3,q4,q5,q6,q7\n";
+  for (int k = 0; k < 100000; ++k)
+    csv += std::to_string(-1.0 + 2.0 * (k % 1000) / 1000) + ",0.1,0,-1.5,0,1.5," +
+           std::to_string(0.001 * (k % 97)) + "\n";
+  write_bytes(dir + "/q.csv", csv);
+  const CommandResult r =
+      run("cd " + quote(dir) + " && (" + quote(tool_path("lazyboe-robot")) +
+          " check --in q.csv --out r.csv & pid=$!; sleep 1.5; kill -TERM $pid; wait $pid)");
+  EXPECT_EQ(r.exit_code, 130) << describe(r);
+  EXPECT_TRUE(contains(r.err, "interrupted")) << r.err;
+  EXPECT_EQ(files_in(dir), std::vector<std::string>{"q.csv"});
+}
+
 }  // namespace
 }  // namespace lazyboe::test

@@ -1,5 +1,6 @@
 // lazyboe-robot: inspect a robot description: its joints and bodies, forward kinematics,
 // inverse dynamics of logged states, collision checks, and the allowed-collision pairs.
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <iostream>
@@ -167,6 +168,13 @@ int cmd_fk(const RobotModel& robot, const std::string& q_text, const std::string
   return 0;
 }
 
+// SIGINT/SIGTERM stop `check` and `torques` before anything is written; the output's temporary
+// file, if any, is removed on the way out.
+int interrupted(const std::string& out) {
+  std::fprintf(stderr, "lazyboe-robot: interrupted; %s not written\n", out.c_str());
+  return 130;
+}
+
 int cmd_torques(const RobotModel& robot, const std::string& in, const std::string& out) {
   const int n = robot.dof;
   std::vector<std::string> header = numbered_columns("q", n);
@@ -174,6 +182,7 @@ int cmd_torques(const RobotModel& robot, const std::string& in, const std::strin
     for (const std::string& c : numbered_columns(p, n)) header.push_back(c);
   }
   const CsvTable table = read_numeric_csv(in, header, {-1e6, 1e6});  // rad, rad/s, rad/s^2
+  install_stop_handlers();
   RobotData data(robot);
   CsvWriter writer(out, numbered_columns("tau", n));
   std::vector<double> row(n);
@@ -183,10 +192,25 @@ int cmd_torques(const RobotModel& robot, const std::string& in, const std::strin
         inverse_dynamics(robot, data, all.segment(0, n), all.segment(n, n), all.segment(2 * n, n));
     for (int i = 0; i < n; ++i) row[i] = tau[i];
     writer.row(row);
+    if (stop_requested()) return interrupted(out);
   }
   writer.commit();
   std::fprintf(stderr, "lazyboe-robot: wrote %zu rows to %s\n", table.rows.size(), out.c_str());
   return 0;
+}
+
+// One configuration's row of `check`: in_limits, self_collision, env_collision, min_distance.
+std::array<double, 4> check_row(const RobotModel& robot, const CollisionModel& cm, RobotData& rd,
+                                CollisionData& cd, const std::vector<double>& r) {
+  Eigen::Map<const Eigen::VectorXd> q(r.data(), robot.dof);
+  const bool in_limits =
+      (q.array() >= robot.q_min.array()).all() && (q.array() <= robot.q_max.array()).all();
+  forward_kinematics(robot, rd, q);
+  update_collision_transforms(cm, cd, rd);
+  const CollisionReport report = check_collision(cm, cd);
+  const DistanceReport dist = min_distance(cm, cd);
+  return {double(in_limits), double(report.self_collision), double(report.env_collision),
+          std::isfinite(dist.min()) ? dist.min() : -1.0};
 }
 
 int cmd_check(const RobotModel& robot, const std::string& env_path, const std::string& in,
@@ -194,22 +218,28 @@ int cmd_check(const RobotModel& robot, const std::string& env_path, const std::s
   const Environment env = load_environment(env_path);
   const CollisionModel cm = build_collision_model(robot, env);
   const CsvTable table = read_numeric_csv(in, numbered_columns("q", robot.dof), {-1e3, 1e3});
-  RobotData rd(robot);
-  CollisionData cd(cm);
+  install_stop_handlers();
+  // Rows are independent: all cores, each thread with its own workspaces (the models are
+  // read-only and shared).
+  const long n = static_cast<long>(table.rows.size());
+  std::vector<std::array<double, 4>> rows(table.rows.size());
+#pragma omp parallel
+  {
+    RobotData rd(robot);
+    CollisionData cd(cm);
+#pragma omp for schedule(dynamic, 256)
+    for (long k = 0; k < n; ++k) {
+      if (!stop_requested()) rows[k] = check_row(robot, cm, rd, cd, table.rows[k]);
+    }
+  }
+  if (stop_requested()) return interrupted(out);
   CsvWriter writer(out, {"in_limits", "self_collision", "env_collision", "min_distance"});
   long colliding = 0;
-  for (const std::vector<double>& r : table.rows) {
-    Eigen::Map<const Eigen::VectorXd> q(r.data(), robot.dof);
-    const bool in_limits =
-        (q.array() >= robot.q_min.array()).all() && (q.array() <= robot.q_max.array()).all();
-    forward_kinematics(robot, rd, q);
-    update_collision_transforms(cm, cd, rd);
-    const CollisionReport report = check_collision(cm, cd);
-    const DistanceReport dist = min_distance(cm, cd);
-    colliding += report.any();
-    writer.row({double(in_limits), double(report.self_collision), double(report.env_collision),
-                std::isfinite(dist.min()) ? dist.min() : -1.0});
+  for (const std::array<double, 4>& r : rows) {
+    colliding += r[1] != 0 || r[2] != 0;
+    writer.row({r[0], r[1], r[2], r[3]});
   }
+  if (stop_requested()) return interrupted(out);
   writer.commit();
   std::fprintf(stderr, "lazyboe-robot: %zu configurations, %ld in collision, written to %s\n",
                table.rows.size(), colliding, out.c_str());
