@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -410,6 +411,47 @@ TEST(Interruption, RobotCheckStoppedBySigtermLeavesNothing) {
   EXPECT_EQ(r.exit_code, 130) << describe(r);
   EXPECT_TRUE(contains(r.err, "interrupted")) << r.err;
   EXPECT_EQ(files_in(dir), std::vector<std::string>{"q.csv"});
+}
+
+// ---- checksums --------------------------------------------------------------------------
+
+TEST(Checksums, VerifyFindsAChangedSampleThatNoRangeCheckCatches) {
+  const std::string dir = fresh_dir("verify");
+  const std::string p = copy_of_small_bundle(dir);
+  const CommandResult ok = tool("lazyboe-build", {"--verify", p});
+  EXPECT_EQ(ok.exit_code, 0) << describe(ok);
+  EXPECT_TRUE(contains(ok.out, p + ": verified (all 20 datasets verify")) << ok.out;
+  EXPECT_TRUE(
+      contains(tool("lazyboe-build", {"--inspect", p}).out, "checksums: all 20 datasets verify"));
+
+  poke<float>(p, "/trajectory/q", 100,
+              0.125f);  // plausible, finite, in range: only a checksum sees it
+  expect_one_line_error(tool("lazyboe-build", {"--verify", p}),
+                        {p, "/trajectory/q: checksum mismatch", "damaged"});
+  const CommandResult inspect = tool("lazyboe-build", {"--inspect", p});
+  EXPECT_EQ(inspect.exit_code, 0) << describe(inspect);
+  EXPECT_TRUE(contains(inspect.out, "checksums: MISMATCH in /trajectory/q")) << inspect.out;
+}
+
+// The same build twice gives the same bytes except the 8 of the wall_seconds attribute (the one
+// timing in an unperturbed bundle): schemas/bundle.md states exactly this.
+TEST(Checksums, RepeatedBuildDiffersOnlyInWallSeconds) {
+  const std::string dir = fresh_dir("twice");
+  for (const char* name : {"a.h5", "b.h5"})
+    ASSERT_EQ(
+        tool("lazyboe-build", {"--edges", "30", "--out", dir + "/" + name, "--quiet"}).exit_code,
+        0);
+  const std::string a = read_file(dir + "/a.h5"), b = read_file(dir + "/b.h5");
+  ASSERT_EQ(a.size(), b.size());
+  size_t first = std::string::npos, last = 0;
+  for (size_t i = 0; i < a.size(); ++i) {
+    if (a[i] == b[i]) continue;
+    first = std::min(first, i);
+    last = i;
+  }
+  if (first != std::string::npos) {
+    EXPECT_LT(last - first, 8u) << "bytes differ from " << first << " to " << last;
+  }
 }
 
 }  // namespace

@@ -81,7 +81,7 @@ void print_summary(const Bundle& b) {
 // The command line. Settings go straight into `settings`, except those that need the robot.
 struct BuildOptions {
   std::string robot_path = default_robot_path(), env_path = default_environment_path();
-  std::string out_path, inspect_path, region = "default", integrator = "euler";
+  std::string out_path, inspect_path, verify_path, region = "default", integrator = "euler";
   BuildSettings settings;
   BuildControl control;
   double sample_interval = 0.05;
@@ -141,6 +141,8 @@ void add_options(CLI::App& app, BuildOptions& o) {
   app.add_flag("--quiet", o.control.quiet, "No progress output");
   app.add_option("--inspect", o.inspect_path,
                  "Print the header and statistics of a bundle, then exit");
+  app.add_option("--verify", o.verify_path,
+                 "Check every dataset's checksum and the bundle's validity, then exit");
 }
 
 // Checks the options that need no file, in the order of their messages' precedence.
@@ -238,7 +240,28 @@ int grow_bundle(const Simulator& sim, BuildOptions& o, Bundle& bundle) {
   return 0;
 }
 
+// --verify: every checksum, then the validation every reader runs. Exit 0 only when both pass.
+int verify(const std::string& path) {
+  const std::vector<DatasetVerification> checks = verify_bundle_checksums(path);
+  for (const DatasetVerification& v : checks) {
+    if (v.status == DatasetVerification::Status::Mismatch)
+      fail(path, v.dataset + ": checksum mismatch (stored " + v.stored + ", computed " +
+                     v.computed + "): the file is damaged");
+    if (v.status == DatasetVerification::Status::NoChecksum)
+      fail(path, v.dataset +
+                     ": no checksum (written before checksums existed; any rewrite, e.g. "
+                     "lazyboe-perturb --bundle FILE, adds them)");
+  }
+  read_bundle(path);
+  for (const DatasetVerification& v : checks)
+    std::printf("ok %s %s\n", v.dataset.c_str(), v.stored.c_str());
+  std::printf("%s: verified (%s; the bundle is valid)\n", path.c_str(),
+              checksum_summary(checks).c_str());
+  return 0;
+}
+
 int run(const CLI::App& app, BuildOptions& o) {
+  if (!o.verify_path.empty()) return verify(o.verify_path);
   if (!o.inspect_path.empty()) {
     print_inspection(o.inspect_path, stdout);
     return 0;
