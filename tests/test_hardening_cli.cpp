@@ -17,8 +17,10 @@
 #include <vector>
 
 #include "cli_util.h"
+#include "lazyboe/bench/report.h"
 #include "lazyboe/bundle/bundle.h"
 #include "lazyboe/bundle/bundle_file.h"
+#include "lazyboe/common/error.h"
 #include "test_util.h"
 
 namespace lazyboe::test {
@@ -451,6 +453,27 @@ TEST(Checksums, RepeatedBuildDiffersOnlyInWallSeconds) {
   }
   if (first != std::string::npos) {
     EXPECT_LT(last - first, 8u) << "bytes differ from " << first << " to " << last;
+  }
+}
+
+// The runs file `lazyboe-bench --resume` reads: numbers strictly too.
+TEST(StrictNumbers, ResumedRunsFileRefusesHexAndNan) {
+  const std::string dir = fresh_dir("runs");
+  std::string header;
+  for (const std::string& c : runs_csv_header()) header += (header.empty() ? "" : ",") + c;
+  for (const char* bad : {"0x10", "nan", "inf", "-1"}) {
+    SCOPED_TRACE(bad);
+    const std::string path = dir + "/runs.csv";
+    write_bytes(path, header + "\nboe,p1,0,7,1," + bad + ",1.5,1,10,20,0,30,5,\n");
+    std::string message;
+    try {
+      read_runs_csv(path, {"p1"});
+    } catch (const Error& e) {
+      message = e.what();
+    }
+    EXPECT_TRUE(contains(message, path + ": line 2") &&
+                contains(message, "time_to_first_solution") && contains(message, bad))
+        << message;
   }
 }
 

@@ -65,8 +65,9 @@ void parse_position_goal(const JsonField& goal, const RobotModel& robot, const Q
                          Goal& g) {
   goal.allow_only({"position", "tolerance", "link"});
   g.kind = Goal::Kind::Position;
-  g.position = goal.at("position").vec3();
-  g.tolerance = goal.has("tolerance") ? goal.at("tolerance").positive() : d.position_tolerance;
+  g.position = goal.at("position").vec3_in({-100, 100}, " m");
+  g.tolerance = goal.has("tolerance") ? goal.at("tolerance").number_in({0, 100, true}, " m")
+                                      : d.position_tolerance;
   const std::string link =
       goal.has("link") ? goal.at("link").string() : robot.links[robot.tip_link()].name;
   g.link = robot.link_index(link);
@@ -78,7 +79,8 @@ void parse_goal(const JsonField& goal, const RobotModel& robot, const QueryDefau
     goal.allow_only({"q", "tolerance"});
     g.kind = Goal::Kind::Joint;
     g.q = joint_vector(goal.at("q"), robot.dof);
-    g.tolerance = goal.has("tolerance") ? goal.at("tolerance").positive() : d.joint_tolerance;
+    g.tolerance = goal.has("tolerance") ? goal.at("tolerance").number_in({0, 1e3, true}, " rad")
+                                        : d.joint_tolerance;
   } else if (goal.has("position")) {
     parse_position_goal(goal, robot, d, g);
   } else {
