@@ -357,8 +357,9 @@ TEST(BundleValidation, EveryToolRefusesTheSameDamageNamingTheDataset) {
                                                  "--no-mmap", "--quiet"}),
                           needles);
     expect_one_line_error(
-        tool("lazyboe-bench", {"--bundle", p, "--out", dir + "/study" + std::to_string(k),
-                               "--problems", "1", "--quiet", "--no-figures"}),
+        tool("lazyboe-bench",
+             {"--bundle", p, "--out", dir + "/study" + std::to_string(k), "--problems", "1",
+              "--budget", "0.1", "--planners", "boe", "--quiet", "--no-figures"}),
         needles);
     EXPECT_EQ(read_file(p), before);
   }
