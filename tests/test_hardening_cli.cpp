@@ -21,6 +21,8 @@
 #include "lazyboe/bundle/bundle.h"
 #include "lazyboe/bundle/bundle_file.h"
 #include "lazyboe/common/error.h"
+#include "lazyboe/common/json_fields.h"
+#include "lazyboe/common/numbers.h"
 #include "test_util.h"
 
 namespace lazyboe::test {
@@ -476,6 +478,41 @@ TEST(StrictNumbers, ResumedRunsFileRefusesHexAndNan) {
                 contains(message, "time_to_first_solution") && contains(message, bad))
         << message;
   }
+}
+
+// ---- the shared parsers, directly -------------------------------------------------------
+
+TEST(StrictParsers, DecimalNumbersOnly) {
+  double v = -7;
+  for (const char* good : {"0", "-1", "+2.5", "1.", ".5", "1e3", "1E-3", "-0.0", "1e-400"}) {
+    EXPECT_TRUE(parse_decimal(good, v)) << good;
+  }
+  EXPECT_TRUE(parse_decimal("2.5e1", v));
+  EXPECT_EQ(v, 25.0);
+  for (const char* bad : {"", " 1", "1 ", "0x10", "inf", "-inf", "nan", "1e400", "1e", "e5", ".",
+                          "1.2.3", "4.97abc", "--1", "1,5"}) {
+    EXPECT_FALSE(parse_decimal(bad, v)) << bad;
+  }
+  EXPECT_EQ(RealRange({0, 1, true}).text(), "(0, 1]");
+  EXPECT_EQ(RealRange({-100, 100}).text(), "[-100, 100]");
+}
+
+TEST(StrictParsers, DuplicateKeysAreRefusedWithTheirPath) {
+  const auto message = [](const std::string& text) {
+    try {
+      parse_json_text(text, "f.json", true);
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("(no error)");
+  };
+  EXPECT_EQ(message(R"({"a": 1, "a": 2})"),
+            "f.json: duplicate key 'a' (each key may appear once in an object)");
+  EXPECT_EQ(message(R"({"objects": [{"x": 1}, {"y": [1, {"z": 1, "z": 2}]}]})"),
+            "f.json: objects[1].y[1]: duplicate key 'z' (each key may appear once in an object)");
+  EXPECT_EQ(message(R"({"a": {"b": 1}, "c": {"b": 1}})"), "(no error)");  // other objects
+  EXPECT_EQ(message("{\n  \"a\": 1e400\n}"), "f.json:2:12: number out of range ('1e400')");
+  EXPECT_EQ(message("{\n  \"a\": \n}"), "f.json:3:1: invalid JSON");
 }
 
 }  // namespace
