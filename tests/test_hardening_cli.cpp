@@ -247,6 +247,16 @@ TEST(StrictNumbers, CsvCellsAndCommandLineNumbersAreDecimalOnly) {
     expect_one_line_error(r, {"--budget", "(0, 1000000] s"});
   }
   EXPECT_FALSE(fs::exists(dir + "/study"));
+  // Integers too: CLI11 alone would read 0x10 as 16 and wrap -1 around to 2^64 - 1.
+  const CommandResult hex = tool("lazyboe-robot", {"allowed-pairs", "--samples", "0x10"});
+  EXPECT_GE(hex.exit_code, 2) << describe(hex);
+  expect_one_line_error(hex, {"--samples", "whole number"});
+  const CommandResult negative =
+      tool("lazyboe-bench", {"--bundle", small_bundle(), "--out", dir + "/study", "--seed", "-1",
+                             "--problems", "1", "--planners", "boe", "--budget", "0.1"});
+  EXPECT_GE(negative.exit_code, 2) << describe(negative);
+  expect_one_line_error(negative, {"--seed", "whole number >= 0"});
+  EXPECT_FALSE(fs::exists(dir + "/study"));
 }
 
 TEST(StrictNumbers, QueryBudgetBeyondTheClockIsAnErrorLine) {

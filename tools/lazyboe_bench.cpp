@@ -104,7 +104,8 @@ void add_options(CLI::App& app, BenchOptions& o) {
       ->capture_default_str()
       ->check(real_in({0, kMaxBudgetSeconds, true}, " s"));
   app.add_option("--seed", o.seed, "Study seed (problems and per-run planner seeds)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(whole_number(true));
   app.add_option("--planners", o.planners,
                  "all, or a comma-separated list of " + planner_names_text() +
                      " (sst = sst-0.5x, sst-1x, sst-2x; see lazyboe-query --list-planners)")

@@ -125,7 +125,8 @@ void add_options(CLI::App& app, BuildOptions& o) {
   app.add_option("--integrator", o.integrator, "euler (semi-implicit) or rk4")
       ->capture_default_str();
   app.add_option("--substeps", s.simulation.substeps, "Integration steps per control period")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(whole_number(false));
   app.add_option("--sample-interval", o.sample_interval, "Stored trajectory spacing, s (0: none)")
       ->capture_default_str()
       ->check(real_in({0, 1e3}, " s"));

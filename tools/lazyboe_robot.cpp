@@ -300,8 +300,12 @@ int main(int argc, char** argv) {
       app.add_subcommand("allowed-pairs", "Derive the allowed-collision link pairs by sampling");
   long samples = 100000;
   uint64_t seed = 1;
-  pairs->add_option("--samples", samples, "Random configurations to test")->capture_default_str();
-  pairs->add_option("--seed", seed, "Random seed")->capture_default_str();
+  pairs->add_option("--samples", samples, "Random configurations to test")
+      ->capture_default_str()
+      ->check(lazyboe::whole_number(false));
+  pairs->add_option("--seed", seed, "Random seed")
+      ->capture_default_str()
+      ->check(lazyboe::whole_number(true));
 
   lazyboe::one_line_cli_errors(app, "lazyboe-robot");
   CLI11_PARSE(app, argc, argv);
