@@ -284,6 +284,7 @@ TEST(DirectoryAsFile, EveryToolNamesItAsADirectory) {
   const std::string dir = fresh_dir("dir-as-file");
   fs::create_directory(dir + "/d");
   const std::string d = dir + "/d";
+  write_bytes(dir + "/q.jsonl", "\n");
   expect_one_line_error(tool("lazyboe-query", {"--bundle", small_bundle(), "--queries", d, "--out",
                                                dir + "/r.jsonl", "--quiet"}),
                         {d, "is a directory"});
@@ -295,6 +296,12 @@ TEST(DirectoryAsFile, EveryToolNamesItAsADirectory) {
   expect_one_line_error(tool("lazyboe-robot", {"check", "--in", d, "--out", dir + "/x"}),
                         {d, "is a directory"});
   expect_one_line_error(tool("lazyboe-build", {"--inspect", d}), {d, "is a directory"});
+  // As an output: said at once, not after the work when the rename fails.
+  expect_one_line_error(tool("lazyboe-build", {"--edges", "3", "--out", d, "--force", "--quiet"}),
+                        {d, "cannot write: is a directory"});
+  expect_one_line_error(tool("lazyboe-query", {"--bundle", small_bundle(), "--queries",
+                                               dir + "/q.jsonl", "--out", d, "--quiet"}),
+                        {d, "cannot write: is a directory"});
   const std::string cfg =
       panda_with(dir, "panda.json", R"("urdf": "panda.urdf")", R"("urdf": "d")");
   expect_one_line_error(tool("lazyboe-robot", {"info", "--robot", cfg}),

@@ -150,6 +150,8 @@ void add_options(CLI::App& app, BuildOptions& o) {
 void check_options(const BuildOptions& o) {
   const BuildSettings& s = o.settings;
   if (o.out_path.empty()) fail("--out", "required (the bundle file to write)");
+  if (std::filesystem::is_directory(o.out_path))
+    fail(o.out_path, "cannot write: is a directory, not a file");
   if (o.resume && o.force) fail("--resume", "cannot be combined with --force");
   if (s.edges == 0) fail("--edges", "must be > 0");
   if (!(s.command.min_duration > 0)) fail("--min-duration", "must be > 0");
