@@ -20,6 +20,7 @@
 #include "lazyboe/robot/robot_model.h"
 #include "lazyboe/sim/rollout_pool.h"
 #include "lazyboe/sim/simulator.h"
+#include "lazyboe/sim/trajectory_check.h"
 
 namespace {
 
@@ -239,6 +240,56 @@ const EdgePool& edge_pool() {
 }
 void BM_SimulateEdge(benchmark::State& state) { run_simulate(state, edge_pool()); }
 BENCHMARK(BM_SimulateEdge);
+
+// The trajectory checker on the same edges sampled at every control tick (as lazyboe-query
+// --sample-interval 0.001 writes them): items are samples, so items_per_second is samples
+// checked per second. Arg 0: without the collision checks.
+struct SampledEdges {
+  std::vector<std::vector<double>> t, q, dq;
+};
+
+const SampledEdges& sampled_edges() {
+  static const SampledEdges sampled = [] {
+    const EdgePool& pool = edge_pool();
+    const int dof = robot().dof;
+    SimulatorWorkspace ws(pool.sim);
+    SampledEdges out;
+    for (const EdgeAttempt& e : pool.edges) {
+      const CommandProfile profile{e.knots.data(), static_cast<int>(e.knots.size() / dof), dof,
+                                   e.command_duration};
+      std::vector<float> sq, sdq;
+      simulate(pool.sim, ws, e.q0, profile, {&sq, &sdq, 1});
+      out.q.emplace_back(sq.begin(), sq.end());
+      out.dq.emplace_back(sdq.begin(), sdq.end());
+      for (int i = 0; i < dof; ++i) out.dq.back()[i] = 0;  // the exact start
+      std::vector<double> t(sq.size() / dof);
+      for (size_t k = 0; k < t.size(); ++k) t[k] = static_cast<double>(k) * pool.sim.dt;
+      out.t.push_back(std::move(t));
+    }
+    return out;
+  }();
+  return sampled;
+}
+
+void BM_CheckTrajectory(benchmark::State& state) {
+  const SampledEdges& edges = sampled_edges();
+  TrajectoryCheckOptions options;
+  options.check_collision = state.range(0) != 0;
+  const TrajectoryChecker checker(robot(), edge_pool().sim.collision, options);
+  TrajectoryCheckWorkspace ws(checker);
+  std::size_t k = 0;
+  int64_t samples = 0;
+  for (auto _ : state) {
+    const TrajectoryView view{static_cast<int>(edges.t[k].size()), robot().dof, edges.t[k].data(),
+                              edges.q[k].data(), edges.dq[k].data()};
+    const TrajectoryCheckResult r = check_trajectory(checker, ws, view);
+    if (!r.valid) state.SkipWithError("an edge of the pool fails the check");
+    samples += r.samples;
+    k = (k + 1) % edges.t.size();
+  }
+  state.SetItemsProcessed(samples);
+}
+BENCHMARK(BM_CheckTrajectory)->Arg(1)->Arg(0);
 
 // The same rollouts in waves on a RolloutPool, as BoE and LazyBoE run an expansion's rollouts
 // (--sim-threads): args are threads and wave size. Items are rollouts, and the time is wall

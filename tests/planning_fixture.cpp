@@ -173,8 +173,15 @@ Trajectory trajectory_from_json(const nlohmann::json& r) {
   for (const nlohmann::json& row : tj.at("q")) t.q.push_back(joint(row.get<std::vector<double>>()));
   for (const nlohmann::json& row : tj.at("dq"))
     t.dq.push_back(joint(row.get<std::vector<double>>()));
+  if (tj.contains("ddq")) {
+    for (const nlohmann::json& row : tj.at("ddq"))
+      t.ddq.push_back(joint(row.get<std::vector<double>>()));
+    for (const nlohmann::json& row : tj.at("cmd"))
+      t.cmd.push_back(joint(row.get<std::vector<double>>()));
+  }
   t.edges = r.at("edges").get<std::vector<int64_t>>();
   t.duration = r.at("duration").get<double>();
+  t.stops = r.value("stops", -1);
   t.cost = r.at("best_cost").get<double>();
   return t;
 }

@@ -76,23 +76,28 @@ std::vector<std::string> fields_of(const std::string& line) {
 
 const std::string kHeader =
     "planner,problem,repeat,seed,success,time_to_first_solution,best_cost,n_solutions,nodes,"
-    "simulations,lazy_edges,collision_checks,budget,failure";
+    "simulations,lazy_edges,collision_checks,budget,failure,duration,stops,arc_length,"
+    "raw_duration,raw_stops,post_seconds,junctions,blends_kept,shortcuts";
 
 bool matplotlib_installed() {
   return std::system("/usr/bin/python3 -c 'import matplotlib' > /dev/null 2>&1") == 0;
 }
 
 // Every row is self-consistent: a success has a time within the budget, a positive cost and at
-// least one solution; a failure has a reason and no time or cost.
+// least one solution, and an executed trajectory no longer than its raw chain with no more
+// stops (the raw chain stops after every step); a failure has a reason and no time or cost.
 void expect_consistent_rows(const std::vector<std::string>& rows, double budget) {
   for (size_t k = 1; k < rows.size(); ++k) {
     const std::vector<std::string> f = fields_of(rows[k]);
-    ASSERT_EQ(f.size(), 14u) << rows[k];
+    ASSERT_EQ(f.size(), 23u) << rows[k];
     EXPECT_GT(std::stoull(f[9]), 0u) << "a run that simulated nothing: " << rows[k];
     if (f[4] == "1") {
       EXPECT_LE(std::stod(f[5]), budget + 0.5) << rows[k];
       EXPECT_GT(std::stod(f[6]), 0) << rows[k];
       EXPECT_GE(std::stoi(f[7]), 1) << rows[k];
+      EXPECT_LE(std::stod(f[14]), std::stod(f[17]) + 1e-3) << rows[k];  // duration <= raw
+      EXPECT_LE(std::stoi(f[15]), std::stoi(f[18])) << rows[k];         // stops <= raw
+      EXPECT_LE(std::stod(f[16]), std::stod(f[6]) + 1e-6) << rows[k];   // arc length <= raw
     } else {
       ASSERT_EQ(f[4], "0") << rows[k];
       EXPECT_TRUE(f[5].empty() && f[6].empty()) << rows[k];
@@ -146,6 +151,7 @@ TEST(BenchCli, TinyStudyWritesEveryFileWithConsistentRows) {
   }
   EXPECT_TRUE(contains(summary, "Mann-Whitney U")) << summary;
   EXPECT_TRUE(contains(summary, "## Targets")) << summary;
+  EXPECT_TRUE(contains(summary, "## Execution")) << summary;
   EXPECT_TRUE(fs::exists(dir + "/study.json"));
   EXPECT_FALSE(fs::exists(dir + "/runs.partial.csv"));
   for (const char* figure :
@@ -289,6 +295,10 @@ TEST(BenchRuns, PartialFileSurvivesATornRowAndRejectsBadFields) {
   a.n_solutions = 1;
   a.counters.simulations = 7;
   a.budget = 1;
+  a.duration = 0.75;
+  a.stops = 1;
+  a.raw_duration = 2.5;
+  a.raw_stops = 3;
   RunRecord b = a;
   b.problem = 1;
   b.success = false;
@@ -311,17 +321,24 @@ TEST(BenchRuns, PartialFileSurvivesATornRowAndRejectsBadFields) {
   ASSERT_EQ(runs.size(), 2u);
   EXPECT_EQ(runs[0].seed, 42u);
   EXPECT_DOUBLE_EQ(runs[0].best_cost, 1.25);
+  EXPECT_DOUBLE_EQ(runs[0].duration, 0.75);
+  EXPECT_EQ(runs[0].stops, 1);
+  EXPECT_DOUBLE_EQ(runs[0].raw_duration, 2.5);
+  EXPECT_EQ(runs[0].raw_stops, 3);
+  EXPECT_EQ(runs[0].junctions, -1);
   EXPECT_FALSE(runs[1].success);
   EXPECT_EQ(runs[1].failure, b.failure);
   EXPECT_TRUE(std::isnan(runs[1].time_to_first_solution));
 
   const std::string header = lines_of(whole)[0];
   for (const auto& [row, field] : std::vector<std::pair<std::string, std::string>>{
-           {"rrt,p0,0,-5,1,0.5,1.25,1,0,7,0,0,1,", "seed"},
-           {"rrt,p0,0,42,yes,0.5,1.25,1,0,7,0,0,1,", "success"},
-           {"rrt,p0,0,42,1,0.5,1.25,1.7,0,7,0,0,1,", "n_solutions"},
-           {"rrt,p0,0,42,1,0.5,1.25,1,0,,0,0,1,", "simulations"},
-           {"rrt,p9,0,42,1,0.5,1.25,1,0,7,0,0,1,", "problem"}}) {
+           {"rrt,p0,0,-5,1,0.5,1.25,1,0,7,0,0,1,,,,,,,,,,", "seed"},
+           {"rrt,p0,0,42,yes,0.5,1.25,1,0,7,0,0,1,,,,,,,,,,", "success"},
+           {"rrt,p0,0,42,1,0.5,1.25,1.7,0,7,0,0,1,,,,,,,,,,", "n_solutions"},
+           {"rrt,p0,0,42,1,0.5,1.25,1,0,,0,0,1,,,,,,,,,,", "simulations"},
+           {"rrt,p9,0,42,1,0.5,1.25,1,0,7,0,0,1,,,,,,,,,,", "problem"},
+           {"rrt,p0,0,42,1,0.5,1.25,1,0,7,0,0,1,,fast,,,,,,,,", "duration"},
+           {"rrt,p0,0,42,1,0.5,1.25,1,0,7,0,0,1,,1.0,-1,,,,,,,", "stops"}}) {
     write_bytes(path, header + "\n" + row + "\n");
     try {
       read_runs_csv(path, ids);

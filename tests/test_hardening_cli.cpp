@@ -484,7 +484,21 @@ TEST(StrictNumbers, ResumedRunsFileRefusesHexAndNan) {
   for (const char* bad : {"0x10", "nan", "inf", "-1"}) {
     SCOPED_TRACE(bad);
     const std::string path = dir + "/runs.csv";
-    write_bytes(path, header + "\nboe,p1,0,7,1," + bad + ",1.5,1,10,20,0,30,5,\n");
+    // A valid row as the writer makes it, with the time to first solution replaced.
+    RunRecord r;
+    r.planner = "boe";
+    r.success = true;
+    r.time_to_first_solution = 0.25;
+    r.best_cost = 1.5;
+    r.budget = 5;
+    std::string row = runs_csv_row(r, "p1");
+    const size_t column = static_cast<size_t>(
+        std::find(runs_csv_header().begin(), runs_csv_header().end(), "time_to_first_solution") -
+        runs_csv_header().begin());
+    size_t from = 0;
+    for (size_t c = 0; c < column; ++c) from = row.find(',', from) + 1;
+    row.replace(from, row.find(',', from) - from, bad);
+    write_bytes(path, header + "\n" + row + "\n");
     std::string message;
     try {
       read_runs_csv(path, {"p1"});

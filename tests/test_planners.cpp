@@ -492,6 +492,7 @@ PlanningContext session_context(const Fixture& f, const Simulator& sim) {
   PlanningContext out{sim, c.bundle, c.index};
   out.end_index = &end_index();
   out.theta = c.theta;
+  out.mean_displacement = c.mean_displacement;
   out.sample_lower = c.sample_lower;
   out.sample_upper = c.sample_upper;
   out.command = c.command;
@@ -565,6 +566,35 @@ TEST(LazySp, ReturnsFullyRevalidatedPathsOfSimulatedEdges) {
                 << r.time_to_first_solution * 1e3 << " ms)\n";
     }
   }
+}
+
+// The edge penalty charges each predicted edge (one simulation each): the lazy search then
+// prefers candidates of fewer, longer edges. Without it, the first solutions of problems across
+// the bundle's region (edge starts over 0.9 rad apart) have more edges in all.
+TEST(LazySp, TheEdgePenaltyFavoursCandidatesOfFewerEdges) {
+  const Fixture& f = fixture();
+  const PlanningContext context = session_context(f, f.sim);
+  EXPECT_EQ(context.mean_displacement, mean_edge_displacement(f.view));
+  EXPECT_GT(context.mean_displacement, 0.05);
+  SimulatorWorkspace ws(f.sim);
+  size_t edges_without = 0, edges_with = 0, problems = 0;
+  for (size_t e = 0; e < f.view.size() && problems < 6; e += 7) {
+    const JointVector from = f.edge_start(e), to = f.edge_start(f.view.size() - 1 - e);
+    if ((to - from).norm() < 0.9) continue;
+    ++problems;
+    PlanningProblem p = library_problem(from, to, 10);
+    p.termination.stop_at_first = true;
+    const PlanResult without = plan(context, ws, "lazysp", {{"edge_penalty", 0.0}}, p);
+    const PlanResult with = plan(context, ws, "lazysp", {{"edge_penalty", 1.0}}, p);
+    ASSERT_TRUE(without.success && with.success);
+    edges_without += without.best_path.size();
+    edges_with += with.best_path.size();
+    expect_revalidated(f, f.sim, p, with);
+  }
+  ASSERT_EQ(problems, 6u);
+  std::cout << "[ lazysp  ] first solutions of 6 problems: " << edges_without
+            << " edges without the penalty, " << edges_with << " with 1 rad per edge\n";
+  EXPECT_LT(edges_with, edges_without);
 }
 
 TEST(LazySp, IdenticalResultsForAFixedSeedWithOrWithoutAPool) {

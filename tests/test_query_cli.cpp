@@ -144,6 +144,10 @@ ToolRun run_batch(const std::string& name, const std::vector<json>& queries,
 // A result without the fields that depend on the wall clock.
 json timeless(json r) {
   r.erase("time_to_first_solution");
+  if (r.contains("post_processing")) {
+    r["post_processing"].erase("seconds");
+    r["post_processing"].erase("raw_seconds");
+  }
   return r;
 }
 
@@ -336,6 +340,31 @@ TEST(QueryCli, EveryReturnedTrajectoryPassesIndependentRevalidation) {
 // 3. No lazy edge in any output
 // ------------------------------------------------------------------------------------------
 
+// A post-processed result: its bundle edges simulated one after another from the start give
+// the raw chain it reports (duration and arc length). Empty when they agree.
+std::string resimulate_raw_chain(const Fixture& f, const JointVectorRef& start,
+                                 const std::vector<CommandProfile>& commands, const json& r) {
+  SimulatorWorkspace ws(f.sim);
+  JointVector q = start;
+  double duration = 0, cost = 0;
+  for (size_t k = 0; k < commands.size(); ++k) {
+    const RolloutResult s = simulate(f.sim, ws, q, commands[k]);
+    if (!s.valid()) return "step " + std::to_string(k) + ": " + rollout_status_name(s.status);
+    q = s.qf;
+    duration += s.duration;
+    cost += s.path_length;
+  }
+  std::ostringstream p;
+  p.precision(17);
+  if (!(std::abs(duration - r.value("raw_duration", -1.0)) <= 1e-9))
+    p << "raw chain duration " << duration << " vs raw_duration " << r["raw_duration"] << "\n";
+  if (!(std::abs(cost - r.value("raw_cost", -1.0)) <= 1e-9))
+    p << "raw chain arc length " << cost << " vs raw_cost " << r["raw_cost"] << "\n";
+  if (r.value("raw_stops", -1) != static_cast<int>(commands.size()) - 1)
+    p << "raw_stops " << r["raw_stops"] << " for " << commands.size() << " steps\n";
+  return p.str();
+}
+
 TEST(QueryCli, OutputsAreMadeOfSimulatedEdgesOnly) {
   const Fixture& f = fixture();
   bool lazy_somewhere = false;
@@ -356,7 +385,11 @@ TEST(QueryCli, OutputsAreMadeOfSimulatedEdgesOnly) {
       bool edges_ok = !traj.edges.empty();
       for (int64_t e : traj.edges) edges_ok &= e >= 0 && e < static_cast<int64_t>(f.view.size());
       ASSERT_TRUE(edges_ok) << r["edges"].dump();
-      EXPECT_EQ(resimulate(f, starts[i], bundle_commands(f, traj.edges), traj), "");
+      if (r.contains("post_processing")) {
+        EXPECT_EQ(resimulate_raw_chain(f, starts[i], bundle_commands(f, traj.edges), r), "");
+      } else {
+        EXPECT_EQ(resimulate(f, starts[i], bundle_commands(f, traj.edges), traj), "");
+      }
     }
   };
   std::vector<JointVector> starts(kPlanners.size(), f.a);
@@ -793,9 +826,10 @@ TEST(QueryCli, CsvTrajectoriesHaveTheInlineRows) {
       run_batch("quick", queries,
                 {"--trajectories", "csv", "--trajectory-dir", traj_dir, "--jobs", "1", "--quiet"});
   expect_batch_ran(t, queries.size());
+  // The raw chain's columns first (as before post-processing), then acceleration and command.
   std::string expected_header = "t";
-  for (int i = 1; i <= 7; ++i) expected_header += ",q" + std::to_string(i);
-  for (int i = 1; i <= 7; ++i) expected_header += ",dq" + std::to_string(i);
+  for (const char* column : {"q", "dq", "ddq", "cmd"})
+    for (int i = 1; i <= 7; ++i) expected_header += "," + std::string(column) + std::to_string(i);
   size_t successes = 0;
   for (size_t i = 0; i < queries.size(); ++i) {
     const json& r = t.results[i];
@@ -819,11 +853,12 @@ TEST(QueryCli, CsvTrajectoriesHaveTheInlineRows) {
     ASSERT_EQ(rows.size(), traj.t.size()) << "CSV rows vs inline samples";
     size_t bad = 0;
     for (size_t k = 0; k < rows.size(); ++k) {
-      ASSERT_EQ(rows[k].size(), 15u) << "row " << k;
+      ASSERT_EQ(rows[k].size(), 29u) << "row " << k;
+      ASSERT_EQ(traj.ddq.size(), traj.t.size());
       std::vector<double> want = {traj.t[k]};
-      for (int j = 0; j < 7; ++j) want.push_back(traj.q[k][j]);
-      for (int j = 0; j < 7; ++j) want.push_back(traj.dq[k][j]);
-      for (size_t c = 0; c < 15; ++c) {
+      for (const std::vector<JointVector>* v : {&traj.q, &traj.dq, &traj.ddq, &traj.cmd})
+        for (int j = 0; j < 7; ++j) want.push_back((*v)[k][j]);
+      for (size_t c = 0; c < 29; ++c) {
         // Written with 10 significant digits.
         if (std::abs(rows[k][c] - want[c]) > 1e-9 * std::max(1.0, std::abs(want[c]))) {
           if (bad++ < 5)
@@ -845,6 +880,101 @@ TEST(QueryCli, CsvTrajectoriesHaveTheInlineRows) {
   EXPECT_EQ(files, successes);
   EXPECT_EQ(successes, queries.size());
   (void)f;
+}
+
+// --raw: the planners' edge chains as they are (the paper's comparisons): the same edges and
+// counters as the post-processed run, the raw figures it reports, and trajectories that are
+// exactly the bundle edges simulated one after another.
+TEST(QueryCli, RawGivesThePlannersEdgeChainsAndPostProcessingIsShorter) {
+  const Fixture& f = fixture();
+  const std::vector<json> queries = quick_queries();
+  const ToolRun& post = deterministic_run();
+  expect_batch_ran(post, deterministic_queries().size());
+  const ToolRun raw =
+      run_batch("quick", queries, {"--trajectories", "inline", "--jobs", "1", "--quiet", "--raw"});
+  expect_batch_ran(raw, queries.size());
+  int shorter = 0;
+  for (size_t i = 0; i < queries.size(); ++i) {
+    const json& r = raw.results[i];
+    const json& p = post.results[i];
+    SCOPED_TRACE(queries[i]["id"].get<std::string>());
+    expect_solved(r, "--raw");
+    EXPECT_FALSE(r.contains("post_processing"));
+    EXPECT_TRUE(p.contains("post_processing"));
+    EXPECT_EQ(r["edges"], p["edges"]);
+    EXPECT_EQ(r["counters"], p["counters"]);
+    EXPECT_EQ(r["n_solutions"], p["n_solutions"]);
+    EXPECT_EQ(r["raw_duration"], r["duration"]);
+    EXPECT_EQ(r["raw_duration"], p["raw_duration"]);
+    EXPECT_EQ(r["best_cost"], p["raw_cost"]);
+    EXPECT_EQ(r["stops"].get<int>(), static_cast<int>(r["edges"].size()) - 1);
+    EXPECT_LE(p["duration"].get<double>(), r["duration"].get<double>());
+    EXPECT_LE(p["stops"].get<int>(), r["stops"].get<int>());
+    shorter += p["duration"].get<double>() < r["duration"].get<double>();
+    if (!r.contains("trajectory") || !is_bundle_planner(r.value("planner", ""))) continue;
+    const Trajectory traj = trajectory_from_json(r);
+    EXPECT_TRUE(traj.ddq.empty()) << "a raw trajectory has the raw columns only";
+    const JointVector start = joint(queries[i]["start"].get<std::vector<double>>());
+    EXPECT_EQ(resimulate(f, start, bundle_commands(f, traj.edges), traj), "");
+  }
+  EXPECT_GT(shorter, 0) << "post-processing never shortened a trajectory";
+}
+
+// Result lines, post-processed and raw, follow schemas/result.schema.json (validated by
+// tests/validate_schemas.py with python3-jsonschema).
+TEST(QueryCli, ResultLinesFollowTheResultSchema) {
+  const ToolRun& post = deterministic_run();
+  expect_batch_ran(post, deterministic_queries().size());
+  std::vector<json> quick = quick_queries();
+  quick.resize(2);
+  const ToolRun raw = run_batch("quick", quick, {"--trajectories", "inline", "--quiet", "--raw"});
+  expect_batch_ran(raw, quick.size());
+  std::string lines;
+  for (const ToolRun* t : {&post, &raw})
+    for (const json& r : t->results) lines += r.dump() + "\n";
+  const std::string file = write_temp_file("results.jsonl", lines);
+  const CommandResult r = run(
+      "/usr/bin/python3 " + quote(std::string(LAZYBOE_SOURCE_DIR) + "/tests/validate_schemas.py") +
+      " " + quote(LAZYBOE_SOURCE_DIR) + " " + quote(file));
+  EXPECT_EQ(r.exit_code, 0) << describe(r);
+}
+
+// --control-rate: one sample per control tick (1 ms), from the exact start at rest to rest
+// inside the goal, with the acceleration and command columns.
+TEST(QueryCli, ControlRateTrajectoriesStartAndEndAtRest) {
+  const Fixture& f = fixture();
+  std::vector<json> queries = quick_queries();
+  queries.resize(2);
+  const std::string dir = fresh_dir("control-rate");
+  const std::string traj_dir = dir + "/trajectories";
+  const ToolRun t = run_batch(
+      "rate", queries,
+      {"--trajectories", "csv", "--trajectory-dir", traj_dir, "--control-rate", "--quiet"});
+  expect_batch_ran(t, queries.size());
+  for (size_t i = 0; i < queries.size(); ++i) {
+    const json& r = t.results[i];
+    SCOPED_TRACE(queries[i]["id"].get<std::string>());
+    expect_solved(r, "--control-rate");
+    std::string header;
+    std::vector<std::vector<double>> rows;
+    ASSERT_TRUE(read_csv(r["trajectory_file"], header, rows));
+    ASSERT_GE(rows.size(), 2u);
+    const JointVector start = joint(queries[i]["start"].get<std::vector<double>>());
+    const JointVector goal = joint(queries[i]["goal"]["q"].get<std::vector<double>>());
+    for (size_t k = 1; k < rows.size(); ++k)
+      ASSERT_NEAR(rows[k][0] - rows[k - 1][0], f.sim.dt, 1e-9) << "row " << k;
+    EXPECT_NEAR(rows.back()[0], r["duration"].get<double>(), 1e-9);
+    for (int j = 0; j < 7; ++j) {
+      EXPECT_NEAR(rows[0][1 + j], start[j], 1e-9);  // 10 significant digits
+      EXPECT_EQ(rows[0][8 + j], 0.0);               // dq
+      EXPECT_EQ(rows[0][15 + j], 0.0);              // ddq
+      EXPECT_LE(std::abs(rows.back()[8 + j]), f.sim.options.settle_velocity);
+      EXPECT_EQ(rows.back()[22 + j], 0.0);  // no command
+    }
+    JointVector last(7);
+    for (int j = 0; j < 7; ++j) last[j] = rows.back()[1 + j];
+    EXPECT_LE((last - goal).norm(), kTolerance);
+  }
 }
 
 // ------------------------------------------------------------------------------------------

@@ -98,8 +98,8 @@ TEST(Registry, NamesAndLookups) {
   EXPECT_EQ(std::set<std::string>(all.begin(), all.end()),
             (std::set<std::string>{"theta", "lazy_model", "goal_bias", "selection_radius",
                                    "pruning_ratio", "epsilon", "resolution", "risk_weight",
-                                   "expansion_limit"}));
-  EXPECT_EQ(all.size(), 9u);  // each once
+                                   "edge_penalty", "expansion_limit"}));
+  EXPECT_EQ(all.size(), 10u);  // each once
 }
 
 TEST(Registry, MakePlannerChecksValues) {

@@ -1,5 +1,6 @@
 #!/usr/bin/env python3
-"""Validates the bundled JSON data files against the JSON Schemas in schemas/."""
+"""Validates the bundled JSON data files (and example result lines) against the JSON Schemas in
+schemas/."""
 import json
 import pathlib
 import sys
@@ -14,13 +15,21 @@ for path in sorted((root / "data/queries").glob("*.jsonl")):
     for n, line in enumerate(path.read_text().splitlines(), 1):
         if line.strip():
             cases.append(("schemas/query.schema.json", (path, n, json.loads(line))))
+# Result lines as lazyboe-query writes them (post-processed, --raw and an error): the examples,
+# and any result files named after ROOT (test_query_cli passes the tool's output).
+results = sorted((root / "data/examples").glob("*results*.jsonl"))
+results += [pathlib.Path(a).absolute() for a in sys.argv[2:]]
+for path in results:
+    for n, line in enumerate(path.read_text().splitlines(), 1):
+        if line.strip():
+            cases.append(("schemas/result.schema.json", (path, n, json.loads(line))))
 passed = failed = 0
 for schema_path, data_path in cases:
     schema = json.loads((root / schema_path).read_text())
     jsonschema.Draft202012Validator.check_schema(schema)
     if isinstance(data_path, tuple):
         data_path, line, doc = data_path
-        name = f"{data_path.relative_to(root)}:{line}"
+        name = f"{data_path}:{line}"
     else:
         doc = json.loads(data_path.read_text())
         name = str(data_path.relative_to(root))

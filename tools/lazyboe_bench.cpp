@@ -44,7 +44,8 @@ std::string machine_description() {
 // The parameters a resumed study must share with the interrupted one.
 nlohmann::json study_parameters(const std::string& bundle, const std::string& planners,
                                 double budget, int repeats, uint64_t seed, int problems,
-                                const std::string& problems_file, double tolerance) {
+                                const std::string& problems_file, double tolerance, bool raw,
+                                int shortcut_attempts) {
   return {{"bundle", fs::absolute(bundle).string()},
           {"planners", planners},
           {"budget", budget},
@@ -52,7 +53,9 @@ nlohmann::json study_parameters(const std::string& bundle, const std::string& pl
           {"seed", seed},
           {"problems", problems},
           {"problems_file", problems_file.empty() ? "" : fs::absolute(problems_file).string()},
-          {"tolerance", tolerance}};
+          {"tolerance", tolerance},
+          {"raw", raw},
+          {"shortcut_attempts", shortcut_attempts}};
 }
 
 void write_text(const fs::path& path, const std::string& text) {
@@ -87,6 +90,8 @@ struct BenchOptions {
   double budget = 60, tolerance = 0;
   uint64_t seed = 1;
   bool resume = false, force = false, no_figures = false, no_mmap = false, quiet = false;
+  bool raw = false;
+  int shortcut_attempts = ExecutionOptions{}.shortcut_attempts;
 };
 
 void add_options(CLI::App& app, BenchOptions& o) {
@@ -126,6 +131,14 @@ void add_options(CLI::App& app, BenchOptions& o) {
   app.add_flag("--force", o.force, "Overwrite the results of an earlier study in --out");
   app.add_flag("--no-figures", o.no_figures, "Do not draw the PNG figures");
   app.add_flag("--no-mmap", o.no_mmap, "Read the bundle into memory instead of mapping it");
+  app.add_flag("--raw", o.raw,
+               "Do not post-process returned paths (runs.csv's execution columns are then the "
+               "raw chain's)");
+  app.add_option("--shortcut-attempts", o.shortcut_attempts,
+                 "Post-processing budget: direct commands tried per path (0: junction blending "
+                 "only)")
+      ->capture_default_str()
+      ->check(whole_number(true));
   app.add_flag("--quiet", o.quiet, "No progress output");
 }
 
@@ -290,7 +303,7 @@ int run(const BenchOptions& o, const std::string& command_line) {
   check_out_dir(o, paths);
   const nlohmann::json parameters =
       study_parameters(o.bundle_path, o.planners, o.budget, o.repeats, o.seed, o.problems,
-                       o.problems_file, o.tolerance);
+                       o.problems_file, o.tolerance, o.raw, o.shortcut_attempts);
   if (o.resume) check_same_study(paths.study, parameters);  // before anything is loaded
 
   planner_specs(o.planners);  // names checked before the bundle is loaded
@@ -333,6 +346,9 @@ int run(const BenchOptions& o, const std::string& command_line) {
   StudyControl control;
   control.jobs = o.jobs;
   control.stop_requested = stop_requested;
+  control.post_process = !o.raw;
+  control.execution.shortcut_attempts = o.shortcut_attempts;
+  control.execution.shortcut = o.shortcut_attempts > 0;
   control.on_run = [&](const RunRecord& r, size_t finished, size_t total) {
     partial.append(r, problem_ids[r.problem]);
     if (!o.quiet) print_run(r, problem_ids[r.problem], finished, total);

@@ -28,6 +28,8 @@ struct Options {
   std::string robot_path, env_path;
   int jobs = 1, sim_threads = 0;
   double sample_interval = 0.01;
+  bool control_rate = false, raw = false;
+  int shortcut_attempts = ExecutionOptions{}.shortcut_attempts;
   bool no_mmap = false, quiet = false;
 };
 
@@ -46,6 +48,8 @@ struct Job {
   int sample_every = 1;
   TrajectoryOutput mode = TrajectoryOutput::None;
   std::string trajectory_dir;
+  bool raw = false;  // the planner's edge chain as it is, no post-processing
+  ExecutionOptions execution;
 };
 
 void add_options(CLI::App& app, Options& o) {
@@ -80,6 +84,15 @@ void add_options(CLI::App& app, Options& o) {
   app.add_option("--sample-interval", o.sample_interval, "Trajectory sample spacing, s")
       ->capture_default_str()
       ->check(real_in({0, 1e3, true}, " s"));
+  app.add_flag("--control-rate", o.control_rate,
+               "Sample every control tick (1 kHz for the Panda): --sample-interval 0.001");
+  app.add_flag("--raw", o.raw,
+               "Return the planner's edge chain as it is (a stop at rest after every step), "
+               "without shortcutting and junction blending");
+  app.add_option("--shortcut-attempts", o.shortcut_attempts,
+                 "Post-processing budget: direct commands tried per path (0: no shortcutting)")
+      ->capture_default_str()
+      ->check(whole_number(true));
   app.add_option("--robot", o.robot_path, "Robot config (default: the bundle's)");
   app.add_option("--env", o.env_path, "Environment (default: the bundle's)");
   app.add_flag("--no-mmap", o.no_mmap, "Read the bundle into memory instead of mapping it");
@@ -131,14 +144,21 @@ std::pair<std::string, Outcome> answer(const Job& job, const std::string& text, 
     }
     const PlanResult r = plan(job.context, ws, q.planner, q.parameters, q.problem, &pool);
     Trajectory traj;
-    if (r.success)
+    ExecutionStats exec;
+    if (r.success && job.raw) {
       traj = realize_path(sim, ws, q.problem.start, r.best_path, q.problem.goal, job.sample_every);
+    } else if (r.success) {
+      ExecutableTrajectory e = make_executable(sim, ws, q.problem.start, r.best_path,
+                                               q.problem.goal, job.execution, job.sample_every);
+      traj = std::move(e.trajectory);
+      exec = e.stats;
+    }
     std::string csv;
     if (r.success && job.mode == TrajectoryOutput::Csv) {
       csv = (std::filesystem::path(job.trajectory_dir) / (q.id + ".csv")).string();
       write_trajectory_csv(csv, traj);
     }
-    j = result_json(q, r, r.success ? &traj : nullptr, job.mode, csv);
+    j = result_json(q, r, r.success ? &traj : nullptr, job.mode, csv, job.raw ? nullptr : &exec);
     o.success = r.success;
     o.ttfs = r.time_to_first_solution;
     o.cost = r.success ? traj.cost : 0;
@@ -245,9 +265,14 @@ int run(const Options& o) {
                                                  {"URDF", session.scene.robot.urdf_path},
                                                  {"environment", session.scene.env.path}});
   report_load(o, session);
-  Job job{session, session.context(), QueryDefaults{}, 1, mode, o.trajectory_dir};
+  Job job{session, session.context(), QueryDefaults{}, 1, mode, o.trajectory_dir, o.raw, {}};
   job.sample_every =
-      std::max(1, sample_every_ticks(o.sample_interval, session.scene.robot.control_rate));
+      o.control_rate
+          ? 1
+          : std::max(1, sample_every_ticks(o.sample_interval, session.scene.robot.control_rate));
+  job.execution.limits = job.context.command;
+  job.execution.shortcut_attempts = o.shortcut_attempts;
+  job.execution.shortcut = o.shortcut_attempts > 0;
 
   // Output: a file written under a temporary name (renamed at the end), or standard output.
   const bool to_stdout = o.out_path == "-";

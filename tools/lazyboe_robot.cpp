@@ -1,5 +1,6 @@
 // lazyboe-robot: inspect a robot description: its joints and bodies, forward kinematics,
-// inverse dynamics of logged states, collision checks, and the allowed-collision pairs.
+// inverse dynamics of logged states, collision checks, the allowed-collision pairs, and
+// whether a joint trajectory is one the robot can execute.
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -11,7 +12,9 @@
 #include "lazyboe/collision/collision_model.h"
 #include "lazyboe/common/file_checks.h"
 #include "lazyboe/io/csv.h"
+#include "lazyboe/io/trajectory_csv.h"
 #include "lazyboe/robot/dynamics.h"
+#include "lazyboe/sim/trajectory_check.h"
 #include "tool_main.h"
 
 namespace {
@@ -262,6 +265,52 @@ int cmd_allowed_pairs(const RobotModel& robot, long samples, uint64_t seed) {
   return 0;
 }
 
+constexpr int kInvalidTrajectory = 3;  // exit status: checked, and a limit is violated
+
+// "valid: N samples, D s; peak fraction of limit: position 0.71 (joint 4), ...".
+std::string check_summary(const TrajectoryCheckResult& r) {
+  static const char* names[kJointLimitCount] = {"position", "velocity", "acceleration",
+                                                "jerk",     "torque",   "torque rate"};
+  char text[512];
+  int used = std::snprintf(text, sizeof text,
+                           "%d samples, %.3f s; peak fraction of limit:", r.samples, r.duration);
+  for (int l = 0; l < kJointLimitCount && used < static_cast<int>(sizeof text); ++l) {
+    used += std::snprintf(text + used, sizeof text - used, "%s %s %.3f (joint %d)", l ? "," : "",
+                          names[l], r.peak_fraction[l], r.peak_joint[l] + 1);
+  }
+  if (used < static_cast<int>(sizeof text)) {
+    std::snprintf(text + used, sizeof text - used, "; %d collision checks", r.collision_checks);
+  }
+  return text;
+}
+
+int cmd_validate_trajectory(const RobotModel& robot, const std::string& env_path,
+                            const std::string& in) {
+  const Environment env = load_environment(env_path);
+  const CollisionModel cm = build_collision_model(robot, env);
+  const TrajectoryChecker checker(robot, cm);
+  const TrajectoryCsv traj = read_trajectory_csv(in, robot.dof);
+  if (traj.t.size() < 2) fail(in + ":" + std::to_string(traj.line[0]), "only one sample");
+  const int bad = first_bad_spacing(checker, traj.view());
+  if (bad >= 0) {
+    char what[256];
+    std::snprintf(what, sizeof what,
+                  "t: %.10g s after the previous sample, not the control period %g s (the "
+                  "check needs every control tick: lazyboe-query --sample-interval %g)",
+                  traj.t[bad] - traj.t[bad - 1], checker.dt, checker.dt);
+    fail(in + ":" + std::to_string(traj.line[bad]), what);
+  }
+  TrajectoryCheckWorkspace ws(checker);
+  const TrajectoryCheckResult r = check_trajectory(checker, ws, traj.view());
+  if (r.valid) {
+    std::printf("valid: %s\n", check_summary(r).c_str());
+    return 0;
+  }
+  std::printf("invalid: %s (%s line %d)\n", describe_violation(checker, r.violation).c_str(),
+              in.c_str(), traj.line[r.violation.sample]);
+  return kInvalidTrajectory;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -307,6 +356,13 @@ int main(int argc, char** argv) {
       ->capture_default_str()
       ->check(lazyboe::whole_number(true));
 
+  auto* validate = app.add_subcommand(
+      "validate-trajectory",
+      "Check a trajectory CSV at the control rate against the limits and for collision");
+  validate->add_option("--in", in_path, "CSV with header t,q1..qn,dq1..dqn[,more columns]")
+      ->required();
+  validate->add_option("--env", env_path, "Environment (JSON)")->capture_default_str();
+
   lazyboe::one_line_cli_errors(app, "lazyboe-robot");
   CLI11_PARSE(app, argc, argv);
   return lazyboe::run_tool("lazyboe-robot", [&]() {
@@ -322,6 +378,7 @@ int main(int argc, char** argv) {
     if (*fk) return cmd_fk(robot, q_text, link_name);
     if (*torques) return cmd_torques(robot, in_path, out_path);
     if (*check) return cmd_check(robot, env_path, in_path, out_path);
+    if (*validate) return cmd_validate_trajectory(robot, env_path, in_path);
     return cmd_allowed_pairs(robot, samples, seed);
   });
 }

@@ -40,14 +40,15 @@ inline CLI::Validator whole_number(bool allow_zero) {
 }
 
 // A real option parsed strictly (plain decimal, finite: "nan", "inf", "0x10" are refused) and
-// within `range`: "--budget: 'nan' is not a finite decimal number (accepted: (0, 1e+06] s)".
+// within `range`: "--budget: 'nan' is not a number (accepted: finite decimal numbers in (0,
+// 1000000] s)".
 inline CLI::Validator real_in(const RealRange& range, const std::string& unit = "") {
   return CLI::Validator(
       [range, unit](std::string& text) -> std::string {
         double v = 0;
         if (!parse_decimal(text, v))
-          return "'" + text + "' is not a finite decimal number (accepted: " + range.text() + unit +
-                 ")";
+          return "'" + text + "' is not a number (accepted: finite decimal numbers in " +
+                 range.text() + unit + ")";
         if (!range.contains(v))
           return number_text(v) + " is outside the accepted range " + range.text() + unit;
         return "";

@@ -84,9 +84,11 @@ uint64_t parse_count(const std::string& text, const std::string& where, const st
 
 const std::vector<std::string>& runs_csv_header() {
   static const std::vector<std::string> header = {
-      "planner",   "problem",     "repeat", "seed",        "success",    "time_to_first_solution",
-      "best_cost", "n_solutions", "nodes",  "simulations", "lazy_edges", "collision_checks",
-      "budget",    "failure"};
+      "planner", "problem", "repeat", "seed", "success", "time_to_first_solution", "best_cost",
+      "n_solutions", "nodes", "simulations", "lazy_edges", "collision_checks", "budget", "failure",
+      // The returned trajectory's execution and the raw chain's (lazyboe-bench --raw: the same).
+      "duration", "stops", "arc_length", "raw_duration", "raw_stops", "post_seconds", "junctions",
+      "blends_kept", "shortcuts"};
   return header;
 }
 
@@ -97,6 +99,11 @@ std::string runs_csv_row(const RunRecord& r, const std::string& problem_id) {
       << number(r.best_cost, "%.6f") << ',' << r.n_solutions << ',' << r.counters.nodes << ','
       << r.counters.simulations << ',' << r.counters.lazy_edges << ','
       << r.counters.collision_checks << ',' << number(r.budget) << ',' << quoted(r.failure);
+  auto count = [](int v) { return v < 0 ? std::string() : std::to_string(v); };
+  row << ',' << number(r.duration, "%.3f") << ',' << count(r.stops) << ','
+      << number(r.arc_length, "%.6f") << ',' << number(r.raw_duration, "%.3f") << ','
+      << count(r.raw_stops) << ',' << number(r.post_seconds, "%.6f") << ',' << count(r.junctions)
+      << ',' << count(r.blends_kept) << ',' << count(r.shortcuts);
   return row.str();
 }
 
@@ -177,6 +184,18 @@ std::vector<RunRecord> read_runs_csv(const std::string& path,
     r.counters.collision_checks = parse_count(fields[11], where, "collision_checks");
     r.budget = parse_number(fields[12], where, "budget");
     r.failure = fields[13];
+    auto count = [&](int k, const char* column) {
+      return fields[k].empty() ? -1 : static_cast<int>(parse_count(fields[k], where, column));
+    };
+    r.duration = parse_number(fields[14], where, "duration");
+    r.stops = count(15, "stops");
+    r.arc_length = parse_number(fields[16], where, "arc_length");
+    r.raw_duration = parse_number(fields[17], where, "raw_duration");
+    r.raw_stops = count(18, "raw_stops");
+    r.post_seconds = parse_number(fields[19], where, "post_seconds");
+    r.junctions = count(20, "junctions");
+    r.blends_kept = count(21, "blends_kept");
+    r.shortcuts = count(22, "shortcuts");
     runs.push_back(std::move(r));
   }
   return runs;
@@ -198,6 +217,10 @@ namespace {
 struct PlannerStats {
   size_t runs = 0, successes = 0;
   std::vector<double> ttfs, cost, solutions, simulations;
+  // Successful runs: the returned trajectory's execution and the raw chain's.
+  std::vector<double> duration, raw_duration, stops, raw_stops, arc_length, post_seconds,
+      ttfs_with_post;
+  long junctions = 0, blends_kept = 0, shortcuts = 0;
 };
 
 std::string fixed(double value, int digits) {
@@ -271,6 +294,32 @@ void write_targets(std::ostream& md, std::map<std::string, PlannerStats>& stats,
   }
 }
 
+// The returned trajectories' execution against the raw chains (issue 14's figures).
+void write_execution(std::ostream& md, std::map<std::string, PlannerStats>& stats,
+                     const std::vector<PlannerSpec>& specs) {
+  md << "\n## Execution\n\n";
+  md << "Over the successful runs: the returned trajectory (post-processed: shortcuts and "
+        "junction blending, docs/execution.md; the raw chain itself with --raw) against the "
+        "raw edge chain. Stops exclude the start and the end. Post-processing runs after the "
+        "planner's clock has stopped, outside the budget; its time is what it adds to the raw "
+        "chain's re-simulation, which every run has.\n\n";
+  md << "| planner | median duration (s) | median raw duration (s) | shorter | median stops | "
+        "median raw stops | median arc length (rad) | median raw arc length (rad) | blends kept "
+        "| shortcuts | median post-processing (s) | median TTFS + post-processing (s) |\n";
+  md << "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+  for (const PlannerSpec& spec : specs) {
+    if (!spec.available) continue;
+    const PlannerStats& s = stats[spec.name];
+    const double d = median_of(s.duration), raw = median_of(s.raw_duration);
+    md << "| " << spec.name << " | " << fixed(d, 2) << " | " << fixed(raw, 2) << " | "
+       << fixed(100 * (1 - d / raw), 0) << "% | " << fixed(median_of(s.stops), 1) << " | "
+       << fixed(median_of(s.raw_stops), 1) << " | " << fixed(median_of(s.arc_length), 2) << " | "
+       << fixed(median_of(s.cost), 2) << " | " << s.blends_kept << " / " << s.junctions << " | "
+       << s.shortcuts << " | " << fixed(median_of(s.post_seconds), 4) << " | "
+       << fixed(median_of(s.ttfs_with_post), 4) << " |\n";
+  }
+}
+
 }  // namespace
 
 std::string summary_markdown(const StudyInfo& info, const std::vector<PlannerSpec>& specs,
@@ -285,6 +334,16 @@ std::string summary_markdown(const StudyInfo& info, const std::vector<PlannerSpe
     ++s.successes;
     s.ttfs.push_back(r.time_to_first_solution);
     s.cost.push_back(r.best_cost);
+    s.duration.push_back(r.duration);
+    s.raw_duration.push_back(r.raw_duration);
+    s.stops.push_back(r.stops);
+    s.raw_stops.push_back(r.raw_stops);
+    s.arc_length.push_back(r.arc_length);
+    s.post_seconds.push_back(r.post_seconds);
+    s.ttfs_with_post.push_back(r.time_to_first_solution + r.post_seconds);
+    s.junctions += std::max(0, r.junctions);
+    s.blends_kept += std::max(0, r.blends_kept);
+    s.shortcuts += std::max(0, r.shortcuts);
   }
   std::ostringstream md;
   md << "# lazyboe-bench summary\n\n";
@@ -314,6 +373,8 @@ std::string summary_markdown(const StudyInfo& info, const std::vector<PlannerSpe
        << fixed(median_of(s.cost), 2) << " | " << fixed(mean_of(s.cost), 2) << " | "
        << fixed(mean_of(s.solutions), 2) << " | " << fixed(median_of(s.simulations), 0) << " |\n";
   }
+
+  write_execution(md, stats, specs);
 
   const bool have_lazy = stats.count("lazyboe") && stats["lazyboe"].runs > 0;
   if (have_lazy) {

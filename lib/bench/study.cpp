@@ -99,6 +99,31 @@ void check_planner_specs(const PlanningContext& context, std::vector<PlannerSpec
   }
 }
 
+namespace {
+
+void record_execution(const PlanningContext& context, SimulatorWorkspace& ws,
+                      const PlanningProblem& p, const PlanResult& result,
+                      const ExecutionOptions& options, RunRecord& r) {
+  ExecutionOptions o = options;
+  o.limits = context.command;
+  const ExecutableTrajectory e =
+      make_executable(context.sim, ws, p.start, result.best_path, p.goal, o, 1000);
+  // The raw chain's figures come from the stage's own re-simulation of it (the same
+  // simulations as realize_path's, so the same cost to the last bit).
+  r.best_cost = e.stats.raw_cost;
+  r.raw_duration = e.stats.raw_duration;
+  r.raw_stops = e.stats.raw_stops;
+  r.duration = e.trajectory.duration;
+  r.stops = e.trajectory.stops;
+  r.arc_length = e.trajectory.cost;
+  r.post_seconds = e.stats.seconds - e.stats.raw_seconds;
+  r.junctions = e.stats.junctions;
+  r.blends_kept = e.stats.blends_kept;
+  r.shortcuts = e.stats.shortcuts;
+}
+
+}  // namespace
+
 uint64_t run_seed(uint64_t study_seed, int problem, int repeat) {
   Random rng(study_seed, (static_cast<uint64_t>(problem) << 20) ^ static_cast<uint64_t>(repeat));
   return rng.next() >> 1;  // fits the query format's non-negative JSON integer
@@ -106,7 +131,7 @@ uint64_t run_seed(uint64_t study_seed, int problem, int repeat) {
 
 RunRecord run_planner(const PlanningContext& context, SimulatorWorkspace& ws,
                       const PlannerSpec& planner, const BenchProblem& problem, int problem_index,
-                      int repeat, uint64_t seed, double budget) {
+                      int repeat, uint64_t seed, double budget, const ExecutionOptions* execution) {
   RunRecord r;
   r.planner = planner.name;
   r.problem = problem_index;
@@ -126,17 +151,21 @@ RunRecord run_planner(const PlanningContext& context, SimulatorWorkspace& ws,
       r.failure = result.failure;
       return r;
     }
-    const Trajectory t = [&] {
-      try {
-        return realize_path(context.sim, ws, p.start, result.best_path, p.goal, 1000);
-      } catch (const Error&) {
-        r.n_solutions = 0;  // the path failed the re-check: it is not a solution
-        throw;
+    try {
+      if (execution) {
+        record_execution(context, ws, p, result, *execution, r);
+      } else {
+        const Trajectory t = realize_path(context.sim, ws, p.start, result.best_path, p.goal, 1000);
+        r.best_cost = r.arc_length = t.cost;
+        r.raw_duration = r.duration = t.duration;
+        r.raw_stops = r.stops = t.stops;
       }
-    }();
+    } catch (const Error&) {
+      r.n_solutions = 0;  // the path failed the re-check: it is not a solution
+      throw;
+    }
     r.success = true;
     r.time_to_first_solution = result.time_to_first_solution;
-    r.best_cost = t.cost;
   } catch (const std::exception& e) {  // nothing may leave a run (an OpenMP region)
     r.success = false;
     r.failure = std::string("error: ") + e.what();
@@ -163,7 +192,8 @@ std::vector<RunRecord> run_study(const PlanningContext& context,
     const StudyTask& task = tasks[k];
     RunRecord r = run_planner(context, workspaces[omp_get_thread_num()], planners[task.planner],
                               problems[task.problem], task.problem, task.repeat,
-                              run_seed(study_seed, task.problem, task.repeat), budget);
+                              run_seed(study_seed, task.problem, task.repeat), budget,
+                              control.post_process ? &control.execution : nullptr);
 #pragma omp critical(lazyboe_study_finished)
     {
       ++finished;

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "lazyboe/bench/problems.h"
+#include "lazyboe/planning/execution.h"
 #include "lazyboe/planning/parameters.h"
 
 namespace lazyboe {
@@ -45,17 +46,32 @@ struct RunRecord {
   PlannerCounters counters;
   double budget = 0;
   std::string failure;  // why there is no solution, or the error
+  // The returned trajectory's execution (execution.h; the raw chain's with post-processing
+  // off) and the raw chain's, for comparison; NaN / -1 without a solution.
+  double duration = std::numeric_limits<double>::quiet_NaN();    // s
+  int stops = -1;                                                // excluding start and end
+  double arc_length = std::numeric_limits<double>::quiet_NaN();  // rad
+  double raw_duration = std::numeric_limits<double>::quiet_NaN();
+  int raw_stops = -1;
+  // Wall time the post-processing adds (beyond the raw chain's re-simulation, which every run
+  // has); not part of the budget.
+  double post_seconds = 0;
+  int junctions = -1, blends_kept = -1, shortcuts = -1;
 };
 
 // The seed of a (problem, repeat) run: the same for every planner, different across repeats.
 uint64_t run_seed(uint64_t study_seed, int problem, int repeat);
 
 // One run. The best path is re-simulated from the exact start with every check
-// (realize_path); its cost is the reported cost, and a path that fails the check is reported
-// as a failed run with the reason (it would be a planner bug).
+// (realize_path, or make_executable's raw pass); its cost is the reported cost (the planner's
+// path, as the paper reports it), and a path that fails the check is reported as a failed run
+// with the reason (it would be a planner bug). With `execution`, the path is also post-processed
+// (make_executable, after the planner's clock has stopped) and the record gets the executed
+// trajectory's figures.
 RunRecord run_planner(const PlanningContext& context, SimulatorWorkspace& ws,
                       const PlannerSpec& planner, const BenchProblem& problem, int problem_index,
-                      int repeat, uint64_t seed, double budget);
+                      int repeat, uint64_t seed, double budget,
+                      const ExecutionOptions* execution = nullptr);
 
 struct StudyTask {
   int planner = 0;  // index into the specs
@@ -68,6 +84,8 @@ struct StudyControl {
   std::function<bool()> stop_requested;  // polled before each run starts
   // Called for each finished run, one at a time (under a lock), in completion order.
   std::function<void(const RunRecord&, size_t finished, size_t total)> on_run;
+  bool post_process = true;  // run_planner's `execution`: post-process every returned path
+  ExecutionOptions execution;
 };
 
 // Runs `tasks`; returns the records of the runs that finished, in task order. Runs in progress

@@ -69,8 +69,8 @@ double parse_real_in(const std::string& text, const RealRange& range, const std:
                      const std::string& unit) {
   double v = 0;
   if (!parse_decimal(text, v))
-    fail(where,
-         "'" + text + "' is not a finite decimal number (accepted: " + range.text() + unit + ")");
+    fail(where, "'" + text + "' is not a number (accepted: finite decimal numbers in " +
+                    range.text() + unit + ")");
   check_in_range(v, range, where, unit);
   return v;
 }

@@ -127,8 +127,28 @@ Query parse_query(const std::string& text, int line, const RobotModel& robot, co
   return q;
 }
 
+namespace {
+
+nlohmann::json rows_json(const std::vector<JointVector>& rows) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const JointVector& v : rows)
+    out.push_back(std::vector<double>(v.data(), v.data() + v.size()));
+  return out;
+}
+
+nlohmann::json execution_json(const ExecutionStats& e) {
+  return {{"raw_steps", e.raw_steps},     {"steps", e.steps},
+          {"shortcuts", e.shortcuts},     {"junctions", e.junctions},
+          {"blends_kept", e.blends_kept}, {"simulations", e.simulations},
+          {"seconds", e.seconds},         {"raw_seconds", e.raw_seconds},
+          {"fell_back", e.fell_back}};
+}
+
+}  // namespace
+
 nlohmann::json result_json(const Query& q, const PlanResult& r, const Trajectory* traj,
-                           TrajectoryOutput mode, const std::string& csv_path) {
+                           TrajectoryOutput mode, const std::string& csv_path,
+                           const ExecutionStats* execution) {
   nlohmann::json j;
   j["id"] = q.id;
   j["line"] = q.line;
@@ -147,15 +167,20 @@ nlohmann::json result_json(const Query& q, const PlanResult& r, const Trajectory
   if (r.success && !r.found_by.empty()) j["found_by"] = r.found_by;
   if (traj) {
     j["duration"] = traj->duration;
+    j["stops"] = traj->stops;
+    j["raw_duration"] = execution ? execution->raw_duration : traj->duration;
+    j["raw_stops"] = execution ? execution->raw_stops : traj->stops;
+    j["raw_cost"] = execution ? execution->raw_cost : traj->cost;
+    if (execution) j["post_processing"] = execution_json(*execution);
     j["edges"] = traj->edges;
     if (mode == TrajectoryOutput::Inline) {
       nlohmann::json t;
       t["t"] = traj->t;
-      for (size_t k = 0; k < traj->q.size(); ++k) {
-        t["q"].push_back(
-            std::vector<double>(traj->q[k].data(), traj->q[k].data() + traj->q[k].size()));
-        t["dq"].push_back(
-            std::vector<double>(traj->dq[k].data(), traj->dq[k].data() + traj->dq[k].size()));
+      t["q"] = rows_json(traj->q);
+      t["dq"] = rows_json(traj->dq);
+      if (!traj->ddq.empty()) {
+        t["ddq"] = rows_json(traj->ddq);
+        t["cmd"] = rows_json(traj->cmd);
       }
       j["trajectory"] = t;
     } else if (mode == TrajectoryOutput::Csv) {
@@ -184,13 +209,21 @@ void write_trajectory_csv(const std::string& path, const Trajectory& traj) {
   std::vector<std::string> header = {"t"};
   for (const std::string& c : numbered_columns("q", n)) header.push_back(c);
   for (const std::string& c : numbered_columns("dq", n)) header.push_back(c);
+  const bool full = !traj.ddq.empty();
+  if (full) {
+    for (const std::string& c : numbered_columns("ddq", n)) header.push_back(c);
+    for (const std::string& c : numbered_columns("cmd", n)) header.push_back(c);
+  }
   CsvWriter w(path, header);
-  std::vector<double> row(1 + 2 * n);
+  std::vector<double> row(header.size());
   for (size_t k = 0; k < traj.t.size(); ++k) {
     row[0] = traj.t[k];
     for (int i = 0; i < n; ++i) {
       row[1 + i] = traj.q[k][i];
       row[1 + n + i] = traj.dq[k][i];
+      if (!full) continue;
+      row[1 + 2 * n + i] = traj.ddq[k][i];
+      row[1 + 3 * n + i] = traj.cmd[k][i];
     }
     w.row(row);
   }

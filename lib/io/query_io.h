@@ -6,6 +6,7 @@
 #include <string>
 
 #include "lazyboe/bundle/bundle_view.h"
+#include "lazyboe/planning/execution.h"
 #include "lazyboe/planning/problem.h"
 #include "lazyboe/planning/registry.h"
 
@@ -36,12 +37,16 @@ Query parse_query(const std::string& text, int line, const RobotModel& robot, co
 
 enum class TrajectoryOutput { None, Inline, Csv };
 
+// `execution`: the post-processing's figures when the trajectory is post-processed
+// (execution.h); null for the raw chain (--raw), whose figures are then the trajectory's own.
 nlohmann::json result_json(const Query& q, const PlanResult& r, const Trajectory* trajectory,
-                           TrajectoryOutput mode, const std::string& csv_path);
+                           TrajectoryOutput mode, const std::string& csv_path,
+                           const ExecutionStats* execution = nullptr);
 nlohmann::json error_json(const std::string& id, int line, const std::string& planner,
                           const std::string& error);
 
-// Writes a trajectory as CSV (t, q1..qn, dq1..dqn).
+// Writes a trajectory as CSV (t, q1..qn, dq1..dqn, and for a post-processed one
+// ddq1..ddqn, cmd1..cmdn).
 void write_trajectory_csv(const std::string& path, const Trajectory& trajectory);
 
 }  // namespace lazyboe

@@ -29,6 +29,7 @@ struct PlanningContext {
   const EdgeIndex* index = nullptr;        // over the edges' start states
   const EdgeIndex* end_index = nullptr;    // over their end states (goal coverage); optional
   double theta = 0;                        // the bundle's theta, rad (0: none)
+  double mean_displacement = 0;            // mean |qf - q0| of the bundle's edges, rad (0: none)
   JointVector sample_lower, sample_upper;  // state sampling box
   CommandSampling command;                 // control family of the sampling planners
 };

@@ -31,12 +31,24 @@ double bundle_theta(const BundleView& bundle) {
   return bundle.has_perturbation() ? bundle.perturbation_theta() : bundle.header().design_theta;
 }
 
+double mean_edge_displacement(const BundleView& bundle) {
+  if (bundle.size() == 0) return 0;
+  const int n = bundle.dof();
+  double sum = 0;
+  for (size_t e = 0; e < bundle.size(); ++e)
+    sum += (Eigen::Map<const Eigen::VectorXd>(bundle.qf(e), n) -
+            Eigen::Map<const Eigen::VectorXd>(bundle.q0(e), n))
+               .norm();
+  return sum / static_cast<double>(bundle.size());
+}
+
 PlanningContext bundle_context(const Simulator& sim, const BundleView& bundle,
                                const EdgeIndex& index, const EdgeIndex* end_index) {
   const BuildSettings settings = settings_from_header(bundle.header());
   PlanningContext c{sim, &bundle, &index};
   c.end_index = end_index;
   c.theta = bundle_theta(bundle);
+  c.mean_displacement = mean_edge_displacement(bundle);
   c.sample_lower = settings.region_lower;
   c.sample_upper = settings.region_upper;
   c.command = settings.command;

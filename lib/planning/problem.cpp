@@ -103,6 +103,7 @@ Trajectory realize_path(const Simulator& sim, SimulatorWorkspace& ws, const Join
     q = r.qf;
   }
   traj.duration = t0;
+  traj.stops = static_cast<int>(steps.size()) - 1;
   if (steps.empty() || !goal.contains(sim.robot, ws.robot, q)) {
     fail("path", "does not end inside the goal region");
   }

@@ -94,9 +94,13 @@ struct PlanResult {
 struct Trajectory {
   std::vector<double> t;
   std::vector<JointVector> q, dq;
+  // Post-processed trajectories only (execution.h), else empty: the acceleration over the
+  // control tick from each sample, and the commanded joint velocity.
+  std::vector<JointVector> ddq, cmd;
   std::vector<int64_t> edges;  // bundle edge of each step (-1 for RRT/SST commands)
   double cost = 0;             // joint-space arc length, rad
   double duration = 0;
+  int stops = 0;  // times it comes to rest between its start and its end
 };
 
 // Simulates `steps` from `start` with every check and returns the trajectory (samples every

@@ -8,8 +8,9 @@
 
 namespace lazyboe {
 
-// Throws Error("<path>:<line>: link 'l' <inertia ixx>: '0.7x' is not a finite decimal number
-// (accepted: [-1e+05, 1e+05] kg m^2)") and the like. `xml_text` must be well-formed XML.
+// Throws Error("<path>:<line>: link 'l' <inertia ixx>: '0.7x' is not a number (accepted:
+// finite decimal numbers in [-1e+05, 1e+05] kg m^2)") and the like. `xml_text` must be well-formed
+// XML.
 void check_urdf_values(const std::string& xml_text, const std::string& path);
 
 }  // namespace lazyboe

@@ -35,8 +35,52 @@ double sample_command_profile(const RobotModel& robot, const CommandSampling& sa
   return duration;
 }
 
+namespace {
+
+// evaluate_command with knot times: the interval holding t by binary search, the offset as the
+// sum of the whole intervals before it.
+void evaluate_timed_command(const CommandProfile& p, double t, double* velocity,
+                            double* acceleration, double* offset) {
+  const int n = p.dof;
+  const int last = p.n_knots - 1;
+  const double* times = p.times;
+  if (t >= p.duration) {
+    for (int i = 0; i < n; ++i) {
+      double sum = 0;
+      for (int j = 0; j < last; ++j)
+        sum += 0.5 * (times[j + 1] - times[j]) * (p.knots[j * n + i] + p.knots[(j + 1) * n + i]);
+      velocity[i] = 0;
+      acceleration[i] = 0;
+      offset[i] = sum;
+    }
+    return;
+  }
+  const int k = std::max(0, static_cast<int>(std::upper_bound(times, times + last, t) - times) - 1);
+  const double h = times[k + 1] - times[k];
+  const double tau = std::min(1.0, std::max(0.0, (t - times[k]) / h));
+  const double tau2 = tau * tau, tau3 = tau2 * tau;
+  const double s = tau3 * (10 - 15 * tau + 6 * tau2);
+  const double ds = 30 * tau2 * (1 - 2 * tau + tau2);
+  const double S = tau2 * tau2 * (2.5 - 3 * tau + tau2);
+  for (int i = 0; i < n; ++i) {
+    double sum = 0;
+    for (int j = 0; j < k; ++j)
+      sum += 0.5 * (times[j + 1] - times[j]) * (p.knots[j * n + i] + p.knots[(j + 1) * n + i]);
+    const double va = p.knots[k * n + i], dv = p.knots[(k + 1) * n + i] - va;
+    velocity[i] = va + dv * s;
+    acceleration[i] = dv * ds / h;
+    offset[i] = sum + h * (va * tau + dv * S);
+  }
+}
+
+}  // namespace
+
 void evaluate_command(const CommandProfile& p, double t, double* velocity, double* acceleration,
                       double* offset) {
+  if (p.times) {
+    evaluate_timed_command(p, t, velocity, acceleration, offset);
+    return;
+  }
   const int n = p.dof;
   const double h = p.interval();
   const int last = p.n_knots - 1;

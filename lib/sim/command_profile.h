@@ -22,12 +22,16 @@ struct CommandSampling {
   double limit_scale = 0.8;     // commanded accel and jerk at most this fraction of the limits
 };
 
-// A view of one profile: n_knots rows of dof velocities, spanning `duration` seconds.
+// A view of one profile: n_knots rows of dof velocities, spanning `duration` seconds, evenly
+// spaced (bundle edges, the sampling planners' commands) or, when `times` is given, at those
+// increasing times (times[0] = 0, times[n_knots - 1] = duration): a path's edges joined into
+// one command (lib/planning/execution.h). The same minimum-jerk blend joins any two knots.
 struct CommandProfile {
   const double* knots = nullptr;
   int n_knots = 0;
   int dof = 0;
   double duration = 0;
+  const double* times = nullptr;  // n_knots knot times, s; null: evenly spaced
   double interval() const { return duration / (n_knots - 1); }
 };
 

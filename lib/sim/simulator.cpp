@@ -59,14 +59,12 @@ int exact_sample_every_ticks(double interval_s, double control_rate, const std::
   return ticks;
 }
 
-namespace {
-
 // r_i: a point of a shape on body b >= i is at most
 //   sum_{k=i+1..b} |origin of joint k in body k-1| + |shape origin in body b| + shape radius
 // from joint i's origin, so turning joint i by dq moves it at most r_i |dq| (a prismatic
 // joint moves everything by exactly |dq|). Summed over joints, this bounds the path length of
 // every point of the robot for a small joint motion.
-JointVector lever_arms(const RobotModel& robot, const CollisionModel& collision) {
+JointVector collision_lever_arms(const RobotModel& robot, const CollisionModel& collision) {
   const int n = robot.dof;
   JointVector r = JointVector::Zero(n);
   for (int i = 0; i < n; ++i) {
@@ -84,6 +82,8 @@ JointVector lever_arms(const RobotModel& robot, const CollisionModel& collision)
   return r;
 }
 
+namespace {
+
 bool within(const JointVector& value, const JointVector& bound) {
   return (value.array().abs() <= bound.array()).all();
 }
@@ -96,7 +96,7 @@ Simulator::Simulator(const RobotModel& robot_model, const CollisionModel& collis
       collision(collision_model),
       options(opts),
       dt(1.0 / robot_model.control_rate),
-      lever_arm(lever_arms(robot_model, collision_model)) {
+      lever_arm(collision_lever_arms(robot_model, collision_model)) {
   if (!robot.controller.present) {
     fail(robot.config_path, "controller: missing (the simulator needs the joint controller gains)");
   }
@@ -129,6 +129,15 @@ RolloutStatus collision_status(const Simulator& sim, SimulatorWorkspace& ws, con
   if (!in_collision(sim.collision, ws.collision)) return RolloutStatus::Valid;
   const CollisionReport report = check_collision(sim.collision, ws.collision);
   return report.env_collision ? RolloutStatus::EnvCollision : RolloutStatus::SelfCollision;
+}
+
+// One row of TrajectorySamples::ticks; its acceleration is filled in once known.
+void push_tick(std::vector<double>& ticks, const JointVector& q, const JointVector& dq,
+               const JointVector& ddq, const JointVector& v_cmd) {
+  ticks.insert(ticks.end(), q.data(), q.data() + q.size());
+  ticks.insert(ticks.end(), dq.data(), dq.data() + dq.size());
+  ticks.insert(ticks.end(), ddq.data(), ddq.data() + ddq.size());
+  ticks.insert(ticks.end(), v_cmd.data(), v_cmd.data() + v_cmd.size());
 }
 
 void push_sample(const TrajectorySamples& samples, const JointVector& q, const JointVector& dq) {
@@ -275,12 +284,15 @@ RolloutResult simulate(const Simulator& sim, SimulatorWorkspace& ws, const Joint
         if (samples.q && (sample_every <= 0 || tick % sample_every != 0)) {
           push_sample(samples, q, dq);
         }
+        if (samples.ticks) push_tick(*samples.ticks, q, dq, ddq_prev, v_cmd);
         return finish(RolloutStatus::Valid, tick);
       }
     }
 
+    if (samples.ticks) push_tick(*samples.ticks, q, dq, ddq_prev, v_cmd);
     q_prev = q;
     integrate_period(sim, rd, tau, h, q, dq, ddq, k);
+    if (samples.ticks) std::copy(ddq.data(), ddq.data() + n, samples.ticks->end() - 2 * n);
     if (!within(ddq, robot.ddq_max)) return finish(RolloutStatus::AccelerationLimit, tick);
     if (!within(ddq - ddq_prev, ddq_step_max)) return finish(RolloutStatus::JerkLimit, tick);
     ddq_prev = ddq;

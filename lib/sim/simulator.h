@@ -60,6 +60,11 @@ double sample_interval_seconds(int ticks, double control_rate);
 // throws Error("<where>: must be a multiple of the control period (<period> s)") otherwise.
 int exact_sample_every_ticks(double interval_s, double control_rate, const std::string& where);
 
+// Per joint: a bound on the motion of any point of the robot's collision shapes per unit
+// motion of that joint, so that lever_arm . |q1 - q0| bounds every point's path for a small
+// joint motion (the collision-check spacing rule).
+JointVector collision_lever_arms(const RobotModel& robot, const CollisionModel& collision);
+
 struct Simulator {
   Simulator(const RobotModel& robot, const CollisionModel& collision, SimulationOptions options);
 
@@ -87,11 +92,15 @@ struct RolloutResult {
 };
 
 // Optional output of a rollout: states every `every` control ticks (0: the simulator's
-// options.sample_every), plus the final state.
+// options.sample_every), plus the final state. `ticks`, when given, gets every control tick
+// in double precision, one row of 4 dof values per tick from the start (tick 0) to the final
+// state: q, dq, ddq (the acceleration over the tick that follows; over the last tick for the
+// final state) and the commanded joint velocity.
 struct TrajectorySamples {
   std::vector<float>* q = nullptr;
   std::vector<float>* dq = nullptr;
   int every = 0;
+  std::vector<double>* ticks = nullptr;
 };
 
 // Simulates from rest at q0. Stops at the first violation. Allocates nothing when the sample

@@ -25,7 +25,8 @@ constexpr double kHeadStart = 50;  // rollouts' worth of lazy work before growth
 constexpr double kLazyShare = 3;   // then lazy work may be up to 3x the growth's
 
 struct Settings {
-  double theta = 0, epsilon = 2, resolution = 0.05, risk_weight = 0.5, goal_bias = 0.05;
+  double theta = 0, epsilon = 2, resolution = 0.05, risk_weight = 0.5, edge_penalty = 0.3,
+         goal_bias = 0.05;
   size_t expansion_limit = 20000;
 };
 
@@ -51,6 +52,7 @@ class LazySpSearch {
         bundle_(*ctx.bundle),
         s_(ctx, ws, p),
         set_(settings_of(theta, values)),
+        h_scale_(ctx.mean_displacement > 0 ? 1 + set_.edge_penalty / ctx.mean_displacement : 1),
         rng_(p.seed, kStream) {}
 
   // Beyond a bundle, the growth needs a sampling box.
@@ -83,6 +85,7 @@ class LazySpSearch {
             v.get("epsilon"),
             v.get("resolution"),
             v.get("risk_weight"),
+            v.get("edge_penalty"),
             v.get("goal_bias"),
             static_cast<size_t>(v.get("expansion_limit"))};
   }
@@ -91,6 +94,8 @@ class LazySpSearch {
   const BundleView& bundle_;
   SearchState s_;
   const Settings set_;
+  // The heuristic counts the edge penalty too: h / mean displacement more edges to the goal.
+  const double h_scale_;
   Random rng_;
   bool goal_covered_ = true;
   std::unordered_set<uint64_t> tried_;  // (real node, edge) pairs simulated, valid or not
@@ -192,7 +197,7 @@ int LazySpSearch::expand(int p) {
     Predicted c;
     c.q = x.q + step;
     if (!within_limits(c.q)) continue;
-    c.g = x.g + step.norm() + risk(e);
+    c.g = x.g + step.norm() + risk(e) + set_.edge_penalty;
     c.length = x.length + step.norm();  // |qf - q0| is a lower bound of the arc length
     c.parent = p;
     c.edge = e;
@@ -215,7 +220,7 @@ bool LazySpSearch::push(Predicted x, double h) {
     if (it->second <= x.g) return false;
     it->second = x.g;
   }
-  open_.emplace(x.g + set_.epsilon * h, static_cast<int>(preds_.size()));
+  open_.emplace(x.g + set_.epsilon * h * h_scale_, static_cast<int>(preds_.size()));
   preds_.push_back(std::move(x));
   return true;
 }
@@ -348,6 +353,9 @@ PlannerInfo lazysp_planner_info() {
       real_parameter(
           "risk_weight", 0.5, 0, false,
           "rad of cost added per unit of an edge's P_collision (0 without perturbation)"),
+      real_parameter("edge_penalty", 0.3, 0, false,
+                     "rad of cost added per predicted edge: favours candidates of fewer edges, "
+                     "each one simulation"),
       goal_bias_parameter(),
       limit,
   };

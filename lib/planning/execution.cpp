@@ -1,0 +1,463 @@
+#include "lazyboe/planning/execution.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "lazyboe/common/error.h"
+
+namespace lazyboe {
+namespace {
+
+// Peak |s'| and |s''| of the minimum-jerk blend on [0, 1] (command_profile.cpp).
+constexpr double kPeakSlope = 1.875;
+constexpr double kPeakCurvature = 5.773502691896258;
+// Fraction of the command limits a direct command between two steps uses.
+constexpr double kJunctionRoom = 0.7;
+
+// A step of the path being processed: its command with knot times, and the raw chain's state
+// it should end at.
+struct Step {
+  std::vector<double> times, knots;
+  JointVector target;
+  int first_raw = 0, last_raw = 0;  // the raw steps it stands for
+  bool uniform = false;             // evenly spaced knots (a raw step's)
+  // A shortcut's accepted simulation from the raw chain's state (the blend pass reuses it for a
+  // segment of this step alone from that same state).
+  bool simulated = false;
+  RolloutResult result;
+  std::vector<double> ticks;
+};
+
+// The raw chain: each step simulated from the previous end, as realize_path does.
+struct RawChain {
+  std::vector<JointVector> states;  // start, then each step's end
+  std::vector<double> cost;         // per step
+  double duration = 0;
+};
+
+struct Work {
+  const Simulator& sim;
+  SimulatorWorkspace& ws;
+  const ExecutionOptions& options;
+  ExecutionStats& stats;
+  std::vector<double> ticks;  // scratch: the last simulation's per-tick rows
+};
+
+bool within_limits(const RobotModel& robot, const CommandSampling& limits, int joint, double dv,
+                   double h) {
+  return kPeakSlope * std::abs(dv) / h <= limits.limit_scale * robot.ddq_max[joint] &&
+         kPeakCurvature * std::abs(dv) / (h * h) <= limits.limit_scale * robot.dddq_max[joint];
+}
+
+RawChain simulate_raw(Work& w, const JointVectorRef& start, const std::vector<PathStep>& steps,
+                      const Goal& goal) {
+  const int n = w.sim.robot.dof;
+  RawChain raw;
+  raw.states.push_back(start);
+  for (size_t k = 0; k < steps.size(); ++k) {
+    const PathStep& s = steps[k];
+    const CommandProfile p{s.knots.data(), static_cast<int>(s.knots.size() / n), n,
+                           s.command_duration};
+    const RolloutResult r = simulate(w.sim, w.ws, raw.states.back(), p);
+    ++w.stats.simulations;
+    if (!r.valid()) {
+      fail("path",
+           "step " + std::to_string(k) + " fails re-validation: " + rollout_status_name(r.status));
+    }
+    raw.states.push_back(r.qf);
+    raw.cost.push_back(r.path_length);
+    raw.duration += r.duration;
+  }
+  if (steps.empty() || !goal.contains(w.sim.robot, w.ws.robot, raw.states.back())) {
+    fail("path", "does not end inside the goal region");
+  }
+  return raw;
+}
+
+std::vector<Step> raw_steps(const std::vector<PathStep>& steps, const RawChain& raw, int n) {
+  std::vector<Step> out(steps.size());
+  for (size_t k = 0; k < steps.size(); ++k) {
+    const int knots = static_cast<int>(steps[k].knots.size() / n);
+    out[k].knots = steps[k].knots;
+    for (int j = 0; j < knots; ++j)
+      out[k].times.push_back(steps[k].command_duration * j / (knots - 1));
+    out[k].target = raw.states[k + 1];
+    out[k].first_raw = out[k].last_raw = static_cast<int>(k);
+    out[k].uniform = true;
+  }
+  return out;
+}
+
+// Adds `delta` (a displacement, per joint) to the commanded displacement of the knots
+// [first, last) of a command, evenly: knot j carries (t_{j+1} - t_{j-1}) / 2 of the integral.
+void correct_command(std::vector<double>& times, std::vector<double>& knots, int first, int last,
+                     const JointVector& delta) {
+  const int n = static_cast<int>(delta.size());
+  double weight = 0;
+  for (int j = first; j < last; ++j) weight += 0.5 * (times[j + 1] - times[j - 1]);
+  if (!(weight > 0)) return;
+  for (int j = first; j < last; ++j)
+    for (int i = 0; i < n; ++i) knots[j * n + i] += delta[i] / weight;
+}
+
+// Simulates a command from rest at q0 into w.ticks; corrects its end offset from `target`
+// (knots [first, last) carry the correction) up to max_corrections times. `offset` is the
+// predicted end offset before any simulation (the start's offset from the raw chain).
+// `uniform`: the knots are evenly spaced, simulated as such (a raw step alone is then its own
+// bundle command, bit for bit).
+RolloutResult simulate_to_target(Work& w, const JointVectorRef& q0, std::vector<double>& times,
+                                 std::vector<double>& knots, int first, int last,
+                                 const JointVector& target, const JointVector& predicted_offset,
+                                 bool uniform = false) {
+  const int n = w.sim.robot.dof;
+  if (predicted_offset.cwiseAbs().maxCoeff() > 0)
+    correct_command(times, knots, first, last, -predicted_offset);
+  RolloutResult r;
+  for (int round = 0;; ++round) {
+    w.ticks.clear();
+    const CommandProfile p{knots.data(), static_cast<int>(times.size()), n, times.back(),
+                           uniform ? nullptr : times.data()};
+    r = simulate(w.sim, w.ws, q0, p, {nullptr, nullptr, 0, &w.ticks});
+    ++w.stats.simulations;
+    if (!r.valid() || round >= w.options.max_corrections) return r;
+    const JointVector residual = target - r.qf;
+    if (residual.cwiseAbs().maxCoeff() <= w.options.correction_tolerance) return r;
+    correct_command(times, knots, first, last, residual);
+  }
+}
+
+}  // namespace
+
+bool direct_command(const RobotModel& robot, const CommandSampling& limits,
+                    const JointVectorRef& displacement, double dt, std::vector<double>& times,
+                    std::vector<double>& knots) {
+  const int n = robot.dof;
+  if (!(displacement.cwiseAbs().maxCoeff() > 1e-9)) return false;
+  int best_intervals = 0;
+  double best_h = 0;
+  for (int intervals = 2; intervals <= 8; ++intervals) {
+    // v_i = D_i / ((N - 1) h): the plateau knots carry the whole displacement.
+    double h = 2 * dt;
+    for (int i = 0; i < n; ++i) {
+      const double d = std::abs(displacement[i]) / (intervals - 1);
+      h = std::max(h, d / (limits.velocity_scale * robot.dq_max[i]));
+      h = std::max(h, std::sqrt(kPeakSlope * d / (limits.limit_scale * robot.ddq_max[i])));
+      h = std::max(h, std::cbrt(kPeakCurvature * d / (limits.limit_scale * robot.dddq_max[i])));
+    }
+    if (best_intervals == 0 || intervals * h < best_intervals * best_h) {
+      best_intervals = intervals;
+      best_h = h;
+    }
+  }
+  times.resize(best_intervals + 1);
+  knots.assign(static_cast<size_t>(best_intervals + 1) * n, 0.0);
+  for (int j = 0; j <= best_intervals; ++j) times[j] = j * best_h;
+  for (int j = 1; j < best_intervals; ++j)
+    for (int i = 0; i < n; ++i)
+      knots[j * n + i] = displacement[i] / ((best_intervals - 1) * best_h);
+  return true;
+}
+
+namespace {
+
+// Shortcut pass: from each step, the farthest later state reachable by one direct command
+// that simulates valid from the raw chain's state, lands near that state (inside the goal for
+// the last) and is shorter than the run it replaces.
+std::vector<Step> shortcut_steps(Work& w, const RawChain& raw, std::vector<Step> steps,
+                                 const Goal& goal) {
+  const int m = static_cast<int>(steps.size());
+  std::vector<Step> out;
+  int attempts = 0;
+  for (int i = 0; i < m;) {
+    int accepted = -1;
+    Step direct;
+    for (int j = m - 1; j > i && attempts < w.options.shortcut_attempts; --j) {
+      double run_cost = 0;
+      for (int k = i; k <= j; ++k) run_cost += raw.cost[k];
+      const JointVector& from = raw.states[i];
+      const JointVector& to = raw.states[j + 1];
+      // A direct command with a neighbouring step keeps room in its acceleration and jerk for
+      // the blends at its junctions (at the limits, no blend of it would fit them).
+      CommandSampling limits = w.options.limits;
+      if (i > 0 || j + 1 < m) limits.limit_scale *= kJunctionRoom;
+      if (!direct_command(w.sim.robot, limits, to - from, w.sim.dt, direct.times, direct.knots))
+        continue;
+      ++attempts;
+      const int last = static_cast<int>(direct.times.size()) - 1;
+      const RolloutResult r = simulate_to_target(w, from, direct.times, direct.knots, 1, last, to,
+                                                 JointVector::Zero(to.size()));
+      const bool lands = r.valid() && (r.qf - to).norm() <= w.options.end_tolerance &&
+                         (j + 1 < m || goal.contains(w.sim.robot, w.ws.robot, r.qf));
+      if (lands && r.path_length < run_cost) {
+        direct.result = r;
+        accepted = j;
+        break;
+      }
+    }
+    if (accepted < 0) {
+      out.push_back(std::move(steps[i]));
+      ++i;
+      continue;
+    }
+    direct.simulated = true;
+    direct.ticks = w.ticks;  // of the accepted simulation, the last one made
+    direct.target = raw.states[accepted + 1];
+    direct.first_raw = i;
+    direct.last_raw = accepted;
+    out.push_back(std::move(direct));
+    ++w.stats.shortcuts;
+    i = accepted + 1;
+  }
+  return out;
+}
+
+// The smallest shortened junction (fraction of its two intervals) whose blend stays within the
+// commanded limits, or 0 when none does. a, b: the knots before and after the junction's zero.
+double blend_scale(const RobotModel& robot, const ExecutionOptions& options, const double* a,
+                   const double* b, double h1, double h2) {
+  const CommandSampling& limits = options.limits;
+  for (double alpha : options.blend_scales) {
+    bool ok = true;
+    for (int i = 0; i < robot.dof && ok; ++i) {
+      const double v = (1 - alpha) / alpha * (h1 * a[i] + h2 * b[i]) / (h1 + h2);
+      ok = std::abs(v) <= limits.velocity_scale * robot.dq_max[i] &&
+           within_limits(robot, limits, i, v - a[i], alpha * h1) &&
+           within_limits(robot, limits, i, b[i] - v, alpha * h2);
+    }
+    if (ok) return alpha;
+  }
+  return 0;
+}
+
+// The joined command of steps [a, b] with the junction after step k shortened to scale[k]:
+// knots, knot times, the time of each junction, and the first knot of the last step.
+struct Joined {
+  std::vector<double> times, knots, junction_time;
+  int last_step_first_knot = 1;
+};
+
+Joined join_steps(const std::vector<Step>& steps, int a, int b, const std::vector<double>& scale,
+                  int n) {
+  Joined j;
+  double shift = 0;  // time of this step's knot 0 in the joined command
+  for (int s = a; s <= b; ++s) {
+    const Step& st = steps[s];
+    const int count = static_cast<int>(st.times.size());
+    const int first = s == a ? 0 : 1;            // knot 0 is the junction knot, already placed
+    const int end = s == b ? count : count - 1;  // the last zero becomes the junction knot
+    if (s == b) j.last_step_first_knot = s == a ? 1 : static_cast<int>(j.times.size());
+    for (int k = first; k < end; ++k) {
+      j.times.push_back(shift + st.times[k]);
+      j.knots.insert(j.knots.end(), st.knots.begin() + k * n, st.knots.begin() + (k + 1) * n);
+    }
+    if (s == b) break;
+    // The junction: intervals h1 (this step's last) and h2 (the next one's first) become
+    // alpha h1 and alpha h2; the junction velocity keeps the commanded displacement.
+    const Step& next = steps[s + 1];
+    const double alpha = scale[s - a];
+    const double h1 = st.times[count - 1] - st.times[count - 2];
+    const double h2 = next.times[1] - next.times[0];
+    const double t_junction = j.times.back() + alpha * h1;
+    const double* ka = &st.knots[(count - 2) * n];
+    const double* kb = &next.knots[n];
+    j.times.push_back(t_junction);
+    j.junction_time.push_back(t_junction);
+    for (int i = 0; i < n; ++i)
+      j.knots.push_back((1 - alpha) / alpha * (h1 * ka[i] + h2 * kb[i]) / (h1 + h2));
+    shift = t_junction + alpha * h2 - next.times[1];
+  }
+  return j;
+}
+
+// Tries segment [a, b] (all its junctions blended, scale[k] after step a + k) from rest at q0.
+// On success fills `segment`; otherwise returns the junction (index after a) nearest to where
+// it failed, or -1 when [a, b] is a single step.
+struct Attempt {
+  bool ok = false;
+  int junction = -1;
+};
+
+Attempt try_segment(Work& w, const std::vector<Step>& steps, const RawChain& raw, int a, int b,
+                    const std::vector<double>& scale, const JointVectorRef& q0, const Goal& goal,
+                    ExecutionSegment& segment) {
+  const int n = w.sim.robot.dof;
+  Joined j = join_steps(steps, a, b, scale, n);
+  const JointVector offset = q0 - raw.states[steps[a].first_raw];
+  const bool uniform = a == b && steps[a].uniform;
+  RolloutResult r;
+  if (a == b && steps[a].simulated && offset.cwiseAbs().maxCoeff() == 0) {
+    r = steps[a].result;  // this very command from this very state: simulated already
+    w.ticks = steps[a].ticks;
+  } else {
+    r = simulate_to_target(w, q0, j.times, j.knots, j.last_step_first_knot,
+                           static_cast<int>(j.times.size()) - 1, steps[b].target, offset, uniform);
+  }
+  const bool last = b + 1 == static_cast<int>(steps.size());
+  const bool lands = r.valid() && (r.qf - steps[b].target).norm() <= w.options.end_tolerance &&
+                     (!last || goal.contains(w.sim.robot, w.ws.robot, r.qf));
+  Attempt at;
+  if (lands) {
+    segment.start = q0;
+    segment.times = std::move(j.times);
+    segment.knots = std::move(j.knots);
+    segment.first_step = a;
+    segment.last_step = b;
+    segment.result = r;
+    segment.uniform = uniform;
+    at.ok = true;
+    return at;
+  }
+  if (j.junction_time.empty()) return at;
+  // A failed check points at the junction nearest to it; a bad end, at the last junction.
+  const double t_fail = r.valid() ? j.times.back() : r.ticks * w.sim.dt;
+  double best = 0;
+  for (size_t k = 0; k < j.junction_time.size(); ++k) {
+    const double d = std::abs(j.junction_time[k] - t_fail);
+    if (at.junction < 0 || d < best) {
+      at.junction = static_cast<int>(k);
+      best = d;
+    }
+  }
+  return at;
+}
+
+// The blend scale of every junction after step a (0: cannot be blended within the limits).
+std::vector<double> junction_scales(const Work& w, const std::vector<Step>& steps, int a) {
+  const int n = w.sim.robot.dof;
+  std::vector<double> scale;
+  for (int s = a; s + 1 < static_cast<int>(steps.size()); ++s) {
+    const Step& st = steps[s];
+    const Step& next = steps[s + 1];
+    const int count = static_cast<int>(st.times.size());
+    scale.push_back(w.options.blend
+                        ? blend_scale(w.sim.robot, w.options, &st.knots[(count - 2) * n],
+                                      &next.knots[n], st.times[count - 1] - st.times[count - 2],
+                                      next.times[1] - next.times[0])
+                        : 0.0);
+  }
+  return scale;
+}
+
+// Blend pass: segments from the left, each as long as its blends allow; a failing junction is
+// first tried again with its longest blend, then split into a stop. False when a single step
+// cannot be simulated from where the previous segment ended (the caller falls back to the
+// raw chain).
+bool blend_segments(Work& w, const std::vector<Step>& steps, const RawChain& raw,
+                    const JointVectorRef& start, const Goal& goal,
+                    std::vector<ExecutionSegment>& segments, std::vector<double>& tick_rows,
+                    std::vector<size_t>& segment_rows) {
+  const int m = static_cast<int>(steps.size());
+  JointVector q0 = start;
+  for (int a = 0; a < m;) {
+    std::vector<double> scale = junction_scales(w, steps, a);
+    std::vector<bool> retried(scale.size(), false);
+    int b = a;
+    while (b + 1 < m && scale[b - a] > 0) ++b;
+    ExecutionSegment seg;
+    for (;;) {
+      const Attempt at = try_segment(w, steps, raw, a, b, scale, q0, goal, seg);
+      if (at.ok) break;
+      if (at.junction < 0) return false;
+      const double longest = w.options.blend_scales.back();
+      if (!retried[at.junction] && scale[at.junction] < longest) {
+        retried[at.junction] = true;
+        scale[at.junction] = longest;
+        continue;
+      }
+      b = a + at.junction;  // the junction after step b keeps its stop
+    }
+    tick_rows.insert(tick_rows.end(), w.ticks.begin(), w.ticks.end());
+    segment_rows.push_back(w.ticks.size());
+    q0 = seg.result.qf;
+    segments.push_back(std::move(seg));
+    a = b + 1;
+  }
+  return true;
+}
+
+// The sampled trajectory of the segments: every `every` control ticks of the whole and each
+// segment's end; a segment's first row is the previous one's end (skipped).
+Trajectory assemble(const Simulator& sim, const std::vector<ExecutionSegment>& segments,
+                    const std::vector<double>& rows, const std::vector<size_t>& segment_rows,
+                    int every) {
+  const int n = sim.robot.dof;
+  const size_t width = 4 * static_cast<size_t>(n);
+  Trajectory t;
+  size_t offset = 0;
+  long tick0 = 0;
+  for (size_t s = 0; s < segments.size(); ++s) {
+    const size_t count = segment_rows[s] / width;
+    for (size_t r = s == 0 ? 0 : 1; r < count; ++r) {
+      const long tick = tick0 + static_cast<long>(r);
+      if (tick % every != 0 && r + 1 != count) continue;
+      const double* row = &rows[offset + r * width];
+      t.t.push_back(tick * sim.dt);
+      t.q.push_back(Eigen::Map<const Eigen::VectorXd>(row, n));
+      t.dq.push_back(Eigen::Map<const Eigen::VectorXd>(row + n, n));
+      t.ddq.push_back(Eigen::Map<const Eigen::VectorXd>(row + 2 * n, n));
+      t.cmd.push_back(Eigen::Map<const Eigen::VectorXd>(row + 3 * n, n));
+    }
+    offset += segment_rows[s];
+    tick0 += static_cast<long>(count) - 1;
+    t.cost += segments[s].result.path_length;
+  }
+  t.duration = tick0 * sim.dt;
+  t.stops = static_cast<int>(segments.size()) - 1;
+  return t;
+}
+
+}  // namespace
+
+ExecutableTrajectory make_executable(const Simulator& sim, SimulatorWorkspace& ws,
+                                     const JointVectorRef& start,
+                                     const std::vector<PathStep>& steps, const Goal& goal,
+                                     const ExecutionOptions& options, int sample_every) {
+  const auto clock_start = std::chrono::steady_clock::now();
+  ExecutableTrajectory out;
+  ExecutionStats& st = out.stats;
+  Work w{sim, ws, options, st, {}};
+  const RawChain raw = simulate_raw(w, start, steps, goal);
+  st.raw_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - clock_start).count();
+  st.raw_steps = static_cast<int>(steps.size());
+  st.raw_duration = raw.duration;
+  for (double c : raw.cost) st.raw_cost += c;
+  st.raw_stops = st.raw_steps - 1;
+
+  std::vector<Step> work = raw_steps(steps, raw, sim.robot.dof);
+  if (options.shortcut) work = shortcut_steps(w, raw, std::move(work), goal);
+  st.steps = static_cast<int>(work.size());
+  st.junctions = st.steps - 1;
+  std::vector<double> rows;
+  std::vector<size_t> segment_rows;
+  if (blend_segments(w, work, raw, start, goal, out.segments, rows, segment_rows)) {
+    out.trajectory = assemble(sim, out.segments, rows, segment_rows, std::max(1, sample_every));
+    st.stops = out.trajectory.stops;
+    st.blends_kept = st.junctions - st.stops;
+  } else {
+    // Nothing better could be validated: the raw chain, at the control rate.
+    st.fell_back = true;
+    out.segments.clear();
+    std::vector<Step> plain = raw_steps(steps, raw, sim.robot.dof);
+    ExecutionOptions stop_all = options;
+    stop_all.blend = false;
+    Work again{sim, ws, stop_all, st, {}};
+    rows.clear();
+    segment_rows.clear();
+    if (!blend_segments(again, plain, raw, start, goal, out.segments, rows, segment_rows))
+      fail("path", "the raw chain fails re-validation");
+    out.trajectory = assemble(sim, out.segments, rows, segment_rows, std::max(1, sample_every));
+    st.steps = st.raw_steps;
+    st.junctions = st.raw_steps - 1;
+    st.shortcuts = 0;
+    st.stops = st.junctions;
+    st.blends_kept = 0;
+  }
+  for (const PathStep& s : steps) out.trajectory.edges.push_back(s.bundle_edge);
+  st.seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - clock_start).count();
+  return out;
+}
+
+}  // namespace lazyboe

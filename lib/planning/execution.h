@@ -1,0 +1,94 @@
+// Post-processing of a returned path into a trajectory a robot can execute as it is (issue 14):
+// a planner's path is a chain of rest-to-rest commands (bundle edges or sampled commands), each
+// simulated with a settle at rest. This stage
+//   1. shortcuts: replaces runs of steps by one direct, straight-line command between their
+//      end states when that simulates valid and is shorter (farthest first, within a budget of
+//      attempts);
+//   2. blends: joins the steps' velocity knots into one command with knot times, drops the
+//      intermediate settles and passes through each junction at a velocity between the two
+//      steps' neighbouring knots, on shortened intervals that keep the commanded displacement;
+//   3. simulates each joined command from rest with every check of the simulator (limits,
+//      continuity, torque and torque rate, collision at margin spacing). A junction whose
+//      blend fails keeps its stop: the command is split there into two rest-to-rest segments.
+// The offset a blend introduces is predicted and corrected through displacement transfer (an
+// edge's command from a shifted start ends shifted by the same amount): the end offset of a
+// segment is added back into its last step's knots, and a segment starting off the raw chain
+// is corrected by its start offset, so every segment ends near the raw chain's state and the
+// last inside the goal region. When anything cannot be made valid, the raw chain is returned
+// as it is. Deterministic: no randomness, no wall clock in any decision.
+#pragma once
+
+#include <vector>
+
+#include "lazyboe/planning/problem.h"
+
+namespace lazyboe {
+
+struct ExecutionOptions {
+  bool shortcut = true;
+  bool blend = true;
+  // The post-processing budget: direct commands tried by the shortcut pass (each is one
+  // simulation plus at most max_corrections). Blending needs no budget of its own: at most
+  // about three simulations per junction.
+  int shortcut_attempts = 12;
+  int max_corrections = 2;             // re-simulations to correct a segment's end offset
+  double correction_tolerance = 2e-3;  // rad (max norm): no correction below this end offset
+  double end_tolerance = 0.01;         // rad: a segment may end this far from the raw chain
+  CommandSampling limits;              // speed and limit fractions of the commands built here
+  // Shortened junction intervals, as fractions of the original two: the first within the
+  // commanded limits is simulated; a failure is tried once more with the last, then stops.
+  std::vector<double> blend_scales = {0.5, 0.6, 0.7, 0.8, 0.9};
+};
+
+// One rest-to-rest command of the executed trajectory: the joined knots of some steps.
+struct ExecutionSegment {
+  JointVector start;                  // at rest
+  std::vector<double> times;          // knot times, s, from 0
+  std::vector<double> knots;          // times.size() rows of dof velocities
+  int first_step = 0, last_step = 0;  // the (post-shortcut) steps it joins
+  RolloutResult result;               // its simulation from `start`
+  bool uniform = false;               // evenly spaced knots, simulated as such (a raw step alone)
+  CommandProfile profile(int dof) const {
+    return {knots.data(), static_cast<int>(times.size()), dof, times.back(),
+            uniform ? nullptr : times.data()};
+  }
+};
+
+struct ExecutionStats {
+  int raw_steps = 0;       // steps of the planner's path
+  int steps = 0;           // after shortcutting
+  int shortcuts = 0;       // runs of raw steps replaced by one direct command
+  int junctions = 0;       // between the steps after shortcutting
+  int blends_kept = 0;     // junctions passed without stopping
+  int stops = 0;           // junctions kept at rest (= junctions - blends_kept)
+  int simulations = 0;     // rollouts simulated by this stage (the raw chain's included)
+  double seconds = 0;      // wall time of this stage (reported, never used in a decision)
+  double raw_seconds = 0;  // of which re-simulating the raw chain (realize_path's work)
+  bool fell_back = false;  // the raw chain is returned as it is
+  double raw_duration = 0, raw_cost = 0;
+  int raw_stops = 0;
+};
+
+struct ExecutableTrajectory {
+  Trajectory trajectory;                   // with ddq and cmd; edges: the planner's bundle edges
+  std::vector<ExecutionSegment> segments;  // empty when fell_back
+  ExecutionStats stats;
+};
+
+// The executable trajectory of a returned path, sampled every `sample_every` control ticks
+// (1: the control rate) plus each segment's end. The first sample is the exact start at rest,
+// the last at rest inside the goal. Throws Error as realize_path does when the raw path itself
+// fails re-validation.
+ExecutableTrajectory make_executable(const Simulator& sim, SimulatorWorkspace& ws,
+                                     const JointVectorRef& start,
+                                     const std::vector<PathStep>& steps, const Goal& goal,
+                                     const ExecutionOptions& options, int sample_every);
+
+// A joint-space straight line from rest by `displacement` to rest, as fast as `limits` allow the
+// commanded velocity, acceleration and jerk (N intervals: knots 0, v, ..., v, 0); false when
+// the displacement is (numerically) zero.
+bool direct_command(const RobotModel& robot, const CommandSampling& limits,
+                    const JointVectorRef& displacement, double dt, std::vector<double>& times,
+                    std::vector<double>& knots);
+
+}  // namespace lazyboe

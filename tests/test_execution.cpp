@@ -1,0 +1,327 @@
+// The execution stage (lib/planning/execution.h) on paths of the small planning bundle:
+// blended and shortcut trajectories pass the fixture's independent re-validation and an
+// independent re-simulation of their joined commands through simulate() (sample by sample at
+// the control rate); a blend that would collide (an obstacle placed on the blended motion at a
+// junction, clear of the raw chain) keeps its stop; first and last samples at rest; the stage
+// without blending or shortcuts is the raw chain bit for bit; the same output on every run and
+// with any thread count (test_query_cli); commands with knot times evaluate as evenly spaced ones
+// do.
+#include <gtest/gtest.h>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "lazyboe/bundle/bundle_view.h"
+#include "lazyboe/collision/environment.h"
+#include "lazyboe/planning/execution.h"
+#include "lazyboe/planning/planning_session.h"
+#include "lazyboe/planning/registry.h"
+#include "lazyboe/robot/kinematics.h"
+#include "planning_fixture.h"
+
+namespace lazyboe::test {
+namespace {
+
+struct Fixture : PlanningFixture {
+  Fixture() : Fixture(build_small_bundles()) {}
+  explicit Fixture(const SmallBundles& built)
+      : PlanningFixture(built.perturbed,
+                        BundleView::from_memory(built.perturbed, "the small bundle (in memory)")) {}
+};
+
+const Fixture& fixture() { return shared_fixture<Fixture>(); }
+
+PlanningProblem problem_to(const JointVectorRef& start, const JointVectorRef& goal) {
+  PlanningProblem p;
+  p.start = start;
+  p.goal.q = goal;
+  p.goal.tolerance = kTolerance;
+  p.termination.budget = 3.0;
+  p.termination.stop_at_first = true;
+  p.seed = 3;
+  return p;
+}
+
+// A path of several bundle edges, a -> c, found once (BoE, deterministic for its seed).
+struct PathCase {
+  PlanningProblem problem;
+  PlanResult result;
+};
+
+const PathCase& long_path() {
+  static const PathCase c = [] {
+    const Fixture& f = fixture();
+    const PlanningContext context = bundle_context(f.sim, f.view, f.index);
+    SimulatorWorkspace ws(f.sim);
+    PathCase out;
+    out.problem = problem_to(f.a, f.c);
+    out.result = plan(context, ws, "boe", {}, out.problem);
+    return out;
+  }();
+  return c;
+}
+
+ExecutionOptions options(bool shortcut, bool blend) {
+  ExecutionOptions o;
+  o.shortcut = shortcut;
+  o.blend = blend;
+  o.limits = bundle_context(fixture().sim, fixture().view, fixture().index).command;
+  return o;
+}
+
+ExecutableTrajectory execute(const Simulator& sim, const PathCase& c, const ExecutionOptions& o) {
+  SimulatorWorkspace ws(sim);
+  return make_executable(sim, ws, c.problem.start, c.result.best_path, c.problem.goal, o, 1);
+}
+
+// Simulates every segment's command again from its start, at every control tick, and compares
+// each sample of the trajectory and the chaining of the segments. Empty when all agree.
+std::string resimulate_segments(const Simulator& sim, const ExecutableTrajectory& e,
+                                const JointVectorRef& start) {
+  std::ostringstream p;
+  const int n = sim.robot.dof;
+  SimulatorWorkspace ws(sim);
+  JointVector q = start;
+  size_t sample = 0;
+  for (size_t s = 0; s < e.segments.size(); ++s) {
+    const ExecutionSegment& seg = e.segments[s];
+    if (!(seg.start == q)) p << "segment " << s << " does not start where the last ended\n";
+    std::vector<double> ticks;
+    const RolloutResult r = simulate(sim, ws, q, seg.profile(n), {nullptr, nullptr, 0, &ticks});
+    if (!r.valid()) {
+      p << "segment " << s << ": " << rollout_status_name(r.status) << "\n";
+      return p.str();
+    }
+    const size_t rows = ticks.size() / (4 * n);
+    for (size_t k = s == 0 ? 0 : 1; k < rows; ++k, ++sample) {
+      if (sample >= e.trajectory.q.size()) return p.str() + "more ticks than samples\n";
+      const double* row = &ticks[k * 4 * n];
+      for (int i = 0; i < n; ++i) {
+        if (row[i] != e.trajectory.q[sample][i] || row[n + i] != e.trajectory.dq[sample][i] ||
+            row[2 * n + i] != e.trajectory.ddq[sample][i] ||
+            row[3 * n + i] != e.trajectory.cmd[sample][i]) {
+          p << "segment " << s << ", tick " << k << ": differs from sample " << sample << "\n";
+          return p.str();
+        }
+      }
+    }
+    q = r.qf;
+  }
+  if (sample != e.trajectory.q.size()) p << "fewer ticks than samples\n";
+  return p.str();
+}
+
+void expect_at_rest_ends(const Simulator& sim, const ExecutableTrajectory& e,
+                         const PlanningProblem& problem) {
+  const Trajectory& t = e.trajectory;
+  ASSERT_FALSE(t.q.empty());
+  EXPECT_EQ(t.t.front(), 0.0);
+  EXPECT_TRUE(t.q.front() == problem.start);
+  EXPECT_EQ(t.dq.front().cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_EQ(t.ddq.front().cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_LE(t.dq.back().cwiseAbs().maxCoeff(), sim.options.settle_velocity);
+  EXPECT_EQ(t.cmd.back().cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_LE((t.ddq.back().array().abs() - sim.robot.dddq_max.array() * sim.dt).maxCoeff(), 0);
+  EXPECT_LE((t.q.back() - problem.goal.q).norm(), problem.goal.tolerance);
+}
+
+TEST(Execution, BlendedTrajectoryPassesReSimulationAndReValidation) {
+  const Fixture& f = fixture();
+  const PathCase& c = long_path();
+  ASSERT_TRUE(c.result.success) << c.result.failure;
+  ASSERT_GE(c.result.best_path.size(), 2u) << "the test needs a path of several edges";
+  const ExecutableTrajectory e = execute(f.sim, c, options(false, true));
+  const ExecutionStats& s = e.stats;
+  EXPECT_FALSE(s.fell_back);
+  EXPECT_EQ(s.shortcuts, 0);
+  EXPECT_EQ(s.junctions, static_cast<int>(c.result.best_path.size()) - 1);
+  EXPECT_GE(s.blends_kept, 1);
+  EXPECT_EQ(s.stops, s.junctions - s.blends_kept);
+  EXPECT_EQ(e.trajectory.stops, s.stops);
+  EXPECT_LT(e.trajectory.duration, s.raw_duration);
+  EXPECT_EQ(resimulate_segments(f.sim, e, c.problem.start), "");
+  EXPECT_EQ(validate(f, e.trajectory, c.problem.start, c.problem.goal.q, kTolerance, "boe"), "");
+  expect_at_rest_ends(f.sim, e, c.problem);
+  std::vector<int64_t> edges;
+  for (const PathStep& step : c.result.best_path) edges.push_back(step.bundle_edge);
+  EXPECT_EQ(e.trajectory.edges, edges);
+}
+
+TEST(Execution, ShortcutTrajectoryPassesReSimulationAndIsShorter) {
+  const Fixture& f = fixture();
+  const PathCase& c = long_path();
+  ASSERT_TRUE(c.result.success) << c.result.failure;
+  const ExecutableTrajectory e = execute(f.sim, c, options(true, true));
+  EXPECT_FALSE(e.stats.fell_back);
+  EXPECT_GE(e.stats.shortcuts, 1);
+  EXPECT_LT(e.stats.steps, e.stats.raw_steps);
+  EXPECT_LE(e.trajectory.cost, e.stats.raw_cost);
+  EXPECT_LT(e.trajectory.duration, e.stats.raw_duration);
+  EXPECT_EQ(resimulate_segments(f.sim, e, c.problem.start), "");
+  EXPECT_EQ(validate(f, e.trajectory, c.problem.start, c.problem.goal.q, kTolerance, "boe"), "");
+  expect_at_rest_ends(f.sim, e, c.problem);
+}
+
+TEST(Execution, WithoutBlendsOrShortcutsItIsTheRawChain) {
+  const Fixture& f = fixture();
+  const PathCase& c = long_path();
+  ASSERT_TRUE(c.result.success) << c.result.failure;
+  const ExecutableTrajectory e = execute(f.sim, c, options(false, false));
+  SimulatorWorkspace ws(f.sim);
+  const Trajectory raw =
+      realize_path(f.sim, ws, c.problem.start, c.result.best_path, c.problem.goal, 1);
+  EXPECT_EQ(e.stats.blends_kept, 0);
+  EXPECT_EQ(e.stats.stops, static_cast<int>(c.result.best_path.size()) - 1);
+  EXPECT_EQ(e.trajectory.stops, raw.stops);
+  EXPECT_TRUE(e.trajectory.q.back() == raw.q.back());  // bit for bit
+  EXPECT_NEAR(e.trajectory.duration, raw.duration, 1e-12);
+  EXPECT_NEAR(e.trajectory.cost, raw.cost, 1e-12);
+  EXPECT_EQ(e.trajectory.t.size(), raw.t.size());
+}
+
+TEST(Execution, SameOutputOnEveryRun) {
+  const Fixture& f = fixture();
+  const PathCase& c = long_path();
+  ASSERT_TRUE(c.result.success) << c.result.failure;
+  const ExecutableTrajectory a = execute(f.sim, c, options(true, true));
+  const ExecutableTrajectory b = execute(f.sim, c, options(true, true));
+  ASSERT_EQ(a.trajectory.q.size(), b.trajectory.q.size());
+  for (size_t k = 0; k < a.trajectory.q.size(); ++k) {
+    ASSERT_TRUE(a.trajectory.q[k] == b.trajectory.q[k]) << "sample " << k;
+    ASSERT_TRUE(a.trajectory.cmd[k] == b.trajectory.cmd[k]) << "sample " << k;
+  }
+  EXPECT_EQ(a.stats.simulations, b.stats.simulations);
+}
+
+// An obstacle where the blended motion passes at a junction but the raw chain does not: the
+// junction keeps its stop, and the trajectory is valid among the obstacles.
+struct Obstructed {
+  Environment env;
+  std::unique_ptr<CollisionModel> collision;
+  std::unique_ptr<Simulator> sim;
+};
+
+bool raw_chain_valid(const Simulator& sim, const PathCase& c) {
+  SimulatorWorkspace ws(sim);
+  try {
+    realize_path(sim, ws, c.problem.start, c.result.best_path, c.problem.goal, 1000);
+    return true;
+  } catch (const std::exception&) {
+    return false;
+  }
+}
+
+// Candidates: a small sphere near a robot shape's centre at a blended state within 0.1 rad of
+// the raw chain's junction state, moved away from where that shape is at the junction; the
+// first that the blended state hits and the raw chain clears.
+bool place_obstacle(const Fixture& f, const PathCase& c, const ExecutableTrajectory& blended,
+                    int junction_step, Obstructed& out) {
+  SimulatorWorkspace ws(f.sim);
+  const Trajectory raw =
+      realize_path(f.sim, ws, c.problem.start, c.result.best_path, c.problem.goal, 1);
+  // The raw chain's junction state: the end of step junction_step.
+  JointVector q_junction = c.problem.start;
+  for (int k = 0; k <= junction_step; ++k) {
+    const RolloutResult r = simulate(f.sim, ws, q_junction, f.view.command(raw.edges[k]));
+    q_junction = r.qf;
+  }
+  RobotData blended_data(f.robot), raw_data(f.robot);
+  for (size_t k = 0; k < blended.trajectory.q.size(); k += 5) {
+    if ((blended.trajectory.q[k] - q_junction).norm() > 0.1) continue;
+    forward_kinematics(f.robot, blended_data, blended.trajectory.q[k]);
+    forward_kinematics(f.robot, raw_data, q_junction);
+    for (const CollisionModel::RobotShape& shape : f.collision.robot) {
+      if (shape.body < 3) continue;
+      const Pose pb = link_pose(f.robot, blended_data, shape.link);
+      const Pose pr = link_pose(f.robot, raw_data, shape.link);
+      const Eigen::Vector3d xb = pb.p + pb.R * shape.in_body.p;
+      const Eigen::Vector3d xr = pr.p + pr.R * shape.in_body.p;
+      const Eigen::Vector3d away = (xb - xr).normalized();
+      for (double reach : {0.9, 0.7, 0.5}) {
+        Obstructed o;
+        o.env = load_environment(f.data.header.env_file);
+        Obstacle ball;
+        ball.name = "junction_ball";
+        ball.shape.type = ShapeType::Sphere;
+        ball.shape.radius = 0.005;
+        ball.pose.p = xb + reach * shape.sphere_radius * away;
+        o.env.obstacles.push_back(ball);
+        o.collision = std::make_unique<CollisionModel>(build_collision_model(f.robot, o.env));
+        o.sim = std::make_unique<Simulator>(f.robot, *o.collision, f.sim.options);
+        SimulatorWorkspace ows(*o.sim);
+        if (check_state(*o.sim, ows, blended.trajectory.q[k]) != RolloutStatus::EnvCollision)
+          continue;
+        if (!raw_chain_valid(*o.sim, c)) continue;
+        out = std::move(o);
+        return true;
+      }
+    }
+  }
+  return false;
+}
+
+TEST(Execution, BlendThatWouldCollideKeepsItsStop) {
+  const Fixture& f = fixture();
+  const PathCase& c = long_path();
+  ASSERT_TRUE(c.result.success) << c.result.failure;
+  // One blend variant, so that the obstacle on it is on every blend tried.
+  ExecutionOptions one_blend = options(false, true);
+  one_blend.blend_scales = {0.5};
+  const ExecutableTrajectory free = execute(f.sim, c, one_blend);
+  ASSERT_EQ(free.stats.stops, 0) << "every junction is blended without the obstacle";
+  Obstructed o;
+  ASSERT_TRUE(place_obstacle(f, c, free, 0, o))
+      << "no obstacle position hits the blend and clears the raw chain";
+  const ExecutableTrajectory e = execute(*o.sim, c, one_blend);
+  EXPECT_FALSE(e.stats.fell_back);
+  EXPECT_GE(e.stats.stops, 1);
+  EXPECT_EQ(resimulate_segments(*o.sim, e, c.problem.start), "");
+  SimulatorWorkspace ws(*o.sim);
+  for (size_t k = 0; k < e.trajectory.q.size(); ++k)
+    ASSERT_EQ(check_state(*o.sim, ws, e.trajectory.q[k]), RolloutStatus::Valid) << "sample " << k;
+  expect_at_rest_ends(*o.sim, e, c.problem);
+}
+
+TEST(Execution, DirectCommandIsAStraightLineWithinTheCommandLimits) {
+  const Fixture& f = fixture();
+  const ExecutionOptions o = options(true, true);
+  const JointVector d = f.c - f.a;
+  std::vector<double> times, knots;
+  ASSERT_TRUE(direct_command(f.robot, o.limits, d, f.sim.dt, times, knots));
+  const int n = f.robot.dof;
+  const CommandProfile p{knots.data(), static_cast<int>(times.size()), n, times.back(),
+                         times.data()};
+  JointVector v(n), a(n), offset(n);
+  evaluate_command(p, p.duration, v.data(), a.data(), offset.data());
+  EXPECT_LE((offset - d).cwiseAbs().maxCoeff(), 1e-12);  // the whole displacement
+  for (double t = 0; t < p.duration; t += 0.01) {
+    evaluate_command(p, t, v.data(), a.data(), offset.data());
+    // Proportional to the displacement: a straight line in joint space.
+    EXPECT_LE((offset - d * (offset.dot(d) / d.squaredNorm())).norm(), 1e-12);
+    EXPECT_LE((v.array().abs() - o.limits.velocity_scale * f.robot.dq_max.array()).maxCoeff(),
+              1e-12);
+    EXPECT_LE((a.array().abs() - o.limits.limit_scale * f.robot.ddq_max.array()).maxCoeff(), 1e-9);
+  }
+  EXPECT_FALSE(direct_command(f.robot, o.limits, JointVector::Zero(n), f.sim.dt, times, knots));
+}
+
+TEST(Execution, KnotTimesEvaluateAsEvenSpacing) {
+  const std::vector<double> knots = {0, 0, 0.3, -0.2, -0.1, 0.4, 0, 0};
+  const std::vector<double> times = {0, 0.2, 0.4, 0.6};
+  const CommandProfile even{knots.data(), 4, 2, 0.6};
+  const CommandProfile timed{knots.data(), 4, 2, 0.6, times.data()};
+  for (double t = 0; t <= 0.7; t += 0.013) {
+    double v1[2], a1[2], o1[2], v2[2], a2[2], o2[2];
+    evaluate_command(even, t, v1, a1, o1);
+    evaluate_command(timed, t, v2, a2, o2);
+    for (int i = 0; i < 2; ++i) {
+      EXPECT_NEAR(v1[i], v2[i], 1e-12) << t;
+      EXPECT_NEAR(a1[i], a2[i], 1e-9) << t;
+      EXPECT_NEAR(o1[i], o2[i], 1e-12) << t;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace lazyboe::test
