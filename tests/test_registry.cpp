@@ -220,9 +220,14 @@ TEST(ValidateProblem, NamesTheFieldAndTheReason) {
   EXPECT_EQ(issue(p), "goal.link: no link 999");
   p = ready_problem();
   p.termination.budget = 0;
-  EXPECT_EQ(issue(p), "budget: must be > 0");
+  EXPECT_EQ(issue(p), "budget: must be in (0, 1000000] s");
   SimulatorWorkspace ws(table().sim);
-  EXPECT_EQ(message_of([&] { validate_problem(table().sim, ws, p); }), "budget: must be > 0");
+  EXPECT_EQ(message_of([&] { validate_problem(table().sim, ws, p); }),
+            "budget: must be in (0, 1000000] s");
+  p.termination.budget = 9.3e9;  // would overflow the deadline's nanosecond clock
+  EXPECT_EQ(issue(p), "budget: must be in (0, 1000000] s");
+  p.termination.budget = std::nan("");
+  EXPECT_EQ(issue(p), "budget: must be in (0, 1000000] s");
 }
 
 // ---- RolloutScheduler ----------------------------------------------------------------------

@@ -107,9 +107,10 @@ void add_options(CLI::App& app, BenchOptions& o) {
                  "study's problems.jsonl)");
   app.add_option("--budget", o.budget, "Wall-clock seconds per run")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(real_in({0, kMaxBudgetSeconds, true}, " s"));
   app.add_option("--seed", o.seed, "Study seed (problems and per-run planner seeds)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(whole_number(true));
   app.add_option("--planners", o.planners,
                  "all, or a comma-separated list of " + planner_names_text() +
                      " (sst = sst-0.5x, sst-1x, sst-2x; see lazyboe-query --list-planners)")
@@ -123,7 +124,7 @@ void add_options(CLI::App& app, BenchOptions& o) {
   app.add_option("--tolerance", o.tolerance,
                  "Radius of the joint-space goal region of drawn problems, rad (default: the "
                  "bundle's theta)")
-      ->check(CLI::PositiveNumber);
+      ->check(real_in({0, 1e3, true}, " rad"));
   app.add_option("--robot", o.robot_path, "Robot config (default: the bundle's)");
   app.add_option("--env", o.env_path, "Environment (default: the bundle's)");
   app.add_flag("--resume", o.resume, "Continue an interrupted study in --out");

@@ -9,6 +9,7 @@
 #include "lazyboe/bundle/builder.h"
 #include "lazyboe/bundle/bundle_file.h"
 #include "lazyboe/bundle/inspect.h"
+#include "lazyboe/common/file_checks.h"
 #include "lazyboe/common/json_fields.h"
 #include "lazyboe/common/version.h"
 #include "tool_main.h"
@@ -80,7 +81,7 @@ void print_summary(const Bundle& b) {
 // The command line. Settings go straight into `settings`, except those that need the robot.
 struct BuildOptions {
   std::string robot_path = default_robot_path(), env_path = default_environment_path();
-  std::string out_path, inspect_path, region = "default", integrator = "euler";
+  std::string out_path, inspect_path, verify_path, region = "default", integrator = "euler";
   BuildSettings settings;
   BuildControl control;
   double sample_interval = 0.05;
@@ -103,26 +104,35 @@ void add_options(CLI::App& app, BuildOptions& o) {
          "--region", o.region,
          "Start-state box: default (robot config), limits, a JSON file, or lo:hi,... per joint")
       ->capture_default_str();
+  const RealRange seconds{0, 1e3, true}, fraction{0, 1, true};
   app.add_option("--min-duration", s.command.min_duration, "Shortest velocity command, s")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(real_in(seconds, " s"));
   app.add_option("--max-duration", s.command.max_duration, "Longest velocity command, s")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(real_in(seconds, " s"));
   app.add_option("--knot-interval", s.command.knot_interval, "Nominal spacing of velocity knots, s")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(real_in(seconds, " s"));
   app.add_option("--velocity-scale", s.command.velocity_scale,
                  "Knot speeds up to this fraction of the velocity limits")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(real_in(fraction));
   app.add_option("--limit-scale", s.command.limit_scale,
                  "Commanded acceleration and jerk up to this fraction of the limits")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(real_in(fraction));
   app.add_option("--integrator", o.integrator, "euler (semi-implicit) or rk4")
       ->capture_default_str();
   app.add_option("--substeps", s.simulation.substeps, "Integration steps per control period")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(whole_number(false));
   app.add_option("--sample-interval", o.sample_interval, "Stored trajectory spacing, s (0: none)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(real_in({0, 1e3}, " s"));
   app.add_option("--theta", s.design_theta, "Neighbourhood radius the bundle is designed for (rad)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(real_in({0, 1e3, true}, " rad"));
   app.add_option("--checkpoint-seconds", o.control.checkpoint_seconds,
                  "Least time between checkpoints")
       ->capture_default_str()
@@ -132,12 +142,16 @@ void add_options(CLI::App& app, BuildOptions& o) {
   app.add_flag("--quiet", o.control.quiet, "No progress output");
   app.add_option("--inspect", o.inspect_path,
                  "Print the header and statistics of a bundle, then exit");
+  app.add_option("--verify", o.verify_path,
+                 "Check every dataset's checksum and the bundle's validity, then exit");
 }
 
 // Checks the options that need no file, in the order of their messages' precedence.
 void check_options(const BuildOptions& o) {
   const BuildSettings& s = o.settings;
   if (o.out_path.empty()) fail("--out", "required (the bundle file to write)");
+  if (std::filesystem::is_directory(o.out_path))
+    fail(o.out_path, "cannot write: is a directory, not a file");
   if (o.resume && o.force) fail("--resume", "cannot be combined with --force");
   if (s.edges == 0) fail("--edges", "must be > 0");
   if (!(s.command.min_duration > 0)) fail("--min-duration", "must be > 0");
@@ -229,7 +243,28 @@ int grow_bundle(const Simulator& sim, BuildOptions& o, Bundle& bundle) {
   return 0;
 }
 
+// --verify: every checksum, then the validation every reader runs. Exit 0 only when both pass.
+int verify(const std::string& path) {
+  const std::vector<DatasetVerification> checks = verify_bundle_checksums(path);
+  for (const DatasetVerification& v : checks) {
+    if (v.status == DatasetVerification::Status::Mismatch)
+      fail(path, v.dataset + ": checksum mismatch (stored " + v.stored + ", computed " +
+                     v.computed + "): the file is damaged");
+    if (v.status == DatasetVerification::Status::NoChecksum)
+      fail(path, v.dataset +
+                     ": no checksum (written before checksums existed; any rewrite, e.g. "
+                     "lazyboe-perturb --bundle FILE, adds them)");
+  }
+  read_bundle(path);
+  for (const DatasetVerification& v : checks)
+    std::printf("ok %s %s\n", v.dataset.c_str(), v.stored.c_str());
+  std::printf("%s: verified (%s; the bundle is valid)\n", path.c_str(),
+              checksum_summary(checks).c_str());
+  return 0;
+}
+
 int run(const CLI::App& app, BuildOptions& o) {
+  if (!o.verify_path.empty()) return verify(o.verify_path);
   if (!o.inspect_path.empty()) {
     print_inspection(o.inspect_path, stdout);
     return 0;
@@ -250,6 +285,10 @@ int run(const CLI::App& app, BuildOptions& o) {
 
   const RobotModel robot = load_robot(o.robot_path);
   const Environment env = load_environment(o.env_path);
+  refuse_output_as_input({"--out", o.out_path}, {{"--robot", o.robot_path},
+                                                 {"URDF", robot.urdf_path},
+                                                 {"--env", o.env_path},
+                                                 {"--region", o.region}});
   const CollisionModel collision = build_collision_model(robot, env);
   s.simulation.sample_every =
       exact_sample_every_ticks(o.sample_interval, robot.control_rate, "--sample-interval");

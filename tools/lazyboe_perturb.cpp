@@ -23,7 +23,8 @@ int main(int argc, char** argv) {
   bool replace = false;
   app.add_option("--bundle", bundle_path, "Bundle file (HDF5), updated in place")->required();
   app.add_option("--theta", s.theta,
-                 "Perturbation radius, rad (default: the bundle's design theta)");
+                 "Perturbation radius, rad (default: the bundle's design theta)")
+      ->check(real_in({0, 1e3, true}, " rad"));
   app.add_option("--perturbations", s.perturbations, "Perturbations per edge (p)")
       ->capture_default_str()
       ->check(whole_number(false));

@@ -12,6 +12,7 @@
 #include <memory>
 
 #include "lazyboe/common/atomic_file.h"
+#include "lazyboe/common/file_checks.h"
 #include "lazyboe/common/histogram.h"
 #include "lazyboe/io/query_io.h"
 #include "lazyboe/planning/planning_session.h"
@@ -81,7 +82,8 @@ void add_options(CLI::App& app, Options& o) {
       ->capture_default_str();
   app.add_option("--trajectory-dir", o.trajectory_dir, "Directory for --trajectories csv");
   app.add_option("--sample-interval", o.sample_interval, "Trajectory sample spacing, s")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(real_in({0, 1e3, true}, " s"));
   app.add_flag("--control-rate", o.control_rate,
                "Sample every control tick (1 kHz for the Panda): --sample-interval 0.001");
   app.add_flag("--raw", o.raw,
@@ -187,6 +189,7 @@ std::vector<Outcome> answer_stream(const Job& job, std::ostream& out, int sim_th
 // A file: `jobs` queries at a time, results in input order.
 std::vector<Outcome> answer_file(const Job& job, const std::string& path, std::ostream& out,
                                  int jobs, int sim_threads) {
+  require_input_file(path, "--queries");
   std::ifstream in(path);
   if (!in) fail(path, "cannot open file");
   std::vector<std::pair<int, std::string>> lines;
@@ -256,6 +259,11 @@ int run(const Options& o) {
   if (o.sim_threads > 1024)
     fail("--sim-threads", "at most 1024, got " + std::to_string(o.sim_threads));
   const PlanningSession session(o.bundle_path, !o.no_mmap, o.robot_path, o.env_path);
+  refuse_output_as_input({"--out", o.out_path}, {{"--bundle", o.bundle_path},
+                                                 {"--queries", o.queries_path},
+                                                 {"robot config", session.scene.robot.config_path},
+                                                 {"URDF", session.scene.robot.urdf_path},
+                                                 {"environment", session.scene.env.path}});
   report_load(o, session);
   Job job{session, session.context(), QueryDefaults{}, 1, mode, o.trajectory_dir, o.raw, {}};
   job.sample_every =

@@ -1,6 +1,7 @@
 // lazyboe-robot: inspect a robot description: its joints and bodies, forward kinematics,
 // inverse dynamics of logged states, collision checks, the allowed-collision pairs, and
 // whether a joint trajectory is one the robot can execute.
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <iostream>
@@ -9,6 +10,7 @@
 
 #include "lazyboe/collision/allowed_pairs.h"
 #include "lazyboe/collision/collision_model.h"
+#include "lazyboe/common/file_checks.h"
 #include "lazyboe/io/csv.h"
 #include "lazyboe/io/trajectory_csv.h"
 #include "lazyboe/robot/dynamics.h"
@@ -27,12 +29,7 @@ JointVector parse_q(const std::string& text, const RobotModel& robot) {
     const size_t comma = std::min(text.find(',', start), text.size());
     const std::string cell = text.substr(start, comma - start);
     start = comma + 1;
-    char* end = nullptr;
-    const double v = std::strtod(cell.c_str(), &end);
-    if (cell.empty() || end == cell.c_str() || *end != '\0')
-      fail("--q", "not a number: '" + cell + "'");
-    if (!std::isfinite(v)) fail("--q", "values must be finite");
-    values.push_back(v);
+    values.push_back(parse_real_in(cell, {-1e3, 1e3}, "--q", " rad or m"));
   }
   if (static_cast<int>(values.size()) != robot.dof) {
     fail("--q", "expected " + std::to_string(robot.dof) + " comma-separated joint values, got " +
@@ -174,13 +171,21 @@ int cmd_fk(const RobotModel& robot, const std::string& q_text, const std::string
   return 0;
 }
 
+// SIGINT/SIGTERM stop `check` and `torques` before anything is written; the output's temporary
+// file, if any, is removed on the way out.
+int interrupted(const std::string& out) {
+  std::fprintf(stderr, "lazyboe-robot: interrupted; %s not written\n", out.c_str());
+  return 130;
+}
+
 int cmd_torques(const RobotModel& robot, const std::string& in, const std::string& out) {
   const int n = robot.dof;
   std::vector<std::string> header = numbered_columns("q", n);
   for (const char* p : {"dq", "ddq"}) {
     for (const std::string& c : numbered_columns(p, n)) header.push_back(c);
   }
-  const CsvTable table = read_numeric_csv(in, header);
+  const CsvTable table = read_numeric_csv(in, header, {-1e6, 1e6});  // rad, rad/s, rad/s^2
+  install_stop_handlers();
   RobotData data(robot);
   CsvWriter writer(out, numbered_columns("tau", n));
   std::vector<double> row(n);
@@ -190,33 +195,54 @@ int cmd_torques(const RobotModel& robot, const std::string& in, const std::strin
         inverse_dynamics(robot, data, all.segment(0, n), all.segment(n, n), all.segment(2 * n, n));
     for (int i = 0; i < n; ++i) row[i] = tau[i];
     writer.row(row);
+    if (stop_requested()) return interrupted(out);
   }
   writer.commit();
   std::fprintf(stderr, "lazyboe-robot: wrote %zu rows to %s\n", table.rows.size(), out.c_str());
   return 0;
 }
 
+// One configuration's row of `check`: in_limits, self_collision, env_collision, min_distance.
+std::array<double, 4> check_row(const RobotModel& robot, const CollisionModel& cm, RobotData& rd,
+                                CollisionData& cd, const std::vector<double>& r) {
+  Eigen::Map<const Eigen::VectorXd> q(r.data(), robot.dof);
+  const bool in_limits =
+      (q.array() >= robot.q_min.array()).all() && (q.array() <= robot.q_max.array()).all();
+  forward_kinematics(robot, rd, q);
+  update_collision_transforms(cm, cd, rd);
+  const CollisionReport report = check_collision(cm, cd);
+  const DistanceReport dist = min_distance(cm, cd);
+  return {double(in_limits), double(report.self_collision), double(report.env_collision),
+          std::isfinite(dist.min()) ? dist.min() : -1.0};
+}
+
 int cmd_check(const RobotModel& robot, const std::string& env_path, const std::string& in,
               const std::string& out) {
   const Environment env = load_environment(env_path);
   const CollisionModel cm = build_collision_model(robot, env);
-  const CsvTable table = read_numeric_csv(in, numbered_columns("q", robot.dof));
-  RobotData rd(robot);
-  CollisionData cd(cm);
+  const CsvTable table = read_numeric_csv(in, numbered_columns("q", robot.dof), {-1e3, 1e3});
+  install_stop_handlers();
+  // Rows are independent: all cores, each thread with its own workspaces (the models are
+  // read-only and shared).
+  const long n = static_cast<long>(table.rows.size());
+  std::vector<std::array<double, 4>> rows(table.rows.size());
+#pragma omp parallel
+  {
+    RobotData rd(robot);
+    CollisionData cd(cm);
+#pragma omp for schedule(dynamic, 256)
+    for (long k = 0; k < n; ++k) {
+      if (!stop_requested()) rows[k] = check_row(robot, cm, rd, cd, table.rows[k]);
+    }
+  }
+  if (stop_requested()) return interrupted(out);
   CsvWriter writer(out, {"in_limits", "self_collision", "env_collision", "min_distance"});
   long colliding = 0;
-  for (const std::vector<double>& r : table.rows) {
-    Eigen::Map<const Eigen::VectorXd> q(r.data(), robot.dof);
-    const bool in_limits =
-        (q.array() >= robot.q_min.array()).all() && (q.array() <= robot.q_max.array()).all();
-    forward_kinematics(robot, rd, q);
-    update_collision_transforms(cm, cd, rd);
-    const CollisionReport report = check_collision(cm, cd);
-    const DistanceReport dist = min_distance(cm, cd);
-    colliding += report.any();
-    writer.row({double(in_limits), double(report.self_collision), double(report.env_collision),
-                std::isfinite(dist.min()) ? dist.min() : -1.0});
+  for (const std::array<double, 4>& r : rows) {
+    colliding += r[1] != 0 || r[2] != 0;
+    writer.row({r[0], r[1], r[2], r[3]});
   }
+  if (stop_requested()) return interrupted(out);
   writer.commit();
   std::fprintf(stderr, "lazyboe-robot: %zu configurations, %ld in collision, written to %s\n",
                table.rows.size(), colliding, out.c_str());
@@ -290,6 +316,8 @@ int cmd_validate_trajectory(const RobotModel& robot, const std::string& env_path
 int main(int argc, char** argv) {
   CLI::App app{"Inspect a robot description: joints, kinematics, dynamics, collision."};
   app.require_subcommand(1);
+  // Tool-wide options (--robot) are accepted after the subcommand too, as users type them.
+  app.fallthrough();
   std::string robot_path = lazyboe::default_robot_path();
   app.add_option("--robot", robot_path, "Robot config (JSON) naming its URDF")
       ->capture_default_str();
@@ -321,8 +349,12 @@ int main(int argc, char** argv) {
       app.add_subcommand("allowed-pairs", "Derive the allowed-collision link pairs by sampling");
   long samples = 100000;
   uint64_t seed = 1;
-  pairs->add_option("--samples", samples, "Random configurations to test")->capture_default_str();
-  pairs->add_option("--seed", seed, "Random seed")->capture_default_str();
+  pairs->add_option("--samples", samples, "Random configurations to test")
+      ->capture_default_str()
+      ->check(lazyboe::whole_number(false));
+  pairs->add_option("--seed", seed, "Random seed")
+      ->capture_default_str()
+      ->check(lazyboe::whole_number(true));
 
   auto* validate = app.add_subcommand(
       "validate-trajectory",
@@ -335,6 +367,13 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
   return lazyboe::run_tool("lazyboe-robot", [&]() {
     const lazyboe::RobotModel robot = lazyboe::load_robot(robot_path);
+    if (*torques || *check) {
+      lazyboe::refuse_output_as_input({"--out", out_path},
+                                      {{"--in", in_path},
+                                       {"--robot", robot_path},
+                                       {"URDF", robot.urdf_path},
+                                       {"--env", *check ? env_path : std::string()}});
+    }
     if (*info) return cmd_info(robot, info_json);
     if (*fk) return cmd_fk(robot, q_text, link_name);
     if (*torques) return cmd_torques(robot, in_path, out_path);

@@ -14,6 +14,7 @@
 #include <string>
 
 #include "lazyboe/common/error.h"
+#include "lazyboe/common/numbers.h"
 
 namespace lazyboe {
 
@@ -38,12 +39,28 @@ inline CLI::Validator whole_number(bool allow_zero) {
       allow_zero ? "INT>=0" : "INT>0");
 }
 
+// A real option parsed strictly (plain decimal, finite: "nan", "inf", "0x10" are refused) and
+// within `range`: "--budget: 'nan' is not a number (accepted: finite decimal numbers in (0,
+// 1000000] s)".
+inline CLI::Validator real_in(const RealRange& range, const std::string& unit = "") {
+  return CLI::Validator(
+      [range, unit](std::string& text) -> std::string {
+        double v = 0;
+        if (!parse_decimal(text, v))
+          return "'" + text + "' is not a number (accepted: finite decimal numbers in " +
+                 range.text() + unit + ")";
+        if (!range.contains(v))
+          return number_text(v) + " is outside the accepted range " + range.text() + unit;
+        return "";
+      },
+      "NUM in " + range.text());
+}
+
 inline CLI::Validator number_at_least_zero() {
   return CLI::Validator(
       [](std::string& text) -> std::string {
-        char* end = nullptr;
-        const double v = std::strtod(text.c_str(), &end);
-        if (text.empty() || *end != '\0' || !(v >= 0) || v > 1e300) return "must be a number >= 0";
+        double v = 0;
+        if (!parse_decimal(text, v) || !(v >= 0) || v > 1e300) return "must be a number >= 0";
         return "";
       },
       "NUM>=0");
@@ -79,6 +96,9 @@ inline bool stop_requested() { return detail::g_stop.load(); }
 
 template <typename Body>
 int run_tool(const char* tool, Body&& body) {
+  // Past a file-size limit (ulimit -f) a write fails with EFBIG and is reported like a full
+  // disk, instead of the signal ending the process.
+  std::signal(SIGXFSZ, SIG_IGN);
   try {
     return body();
   } catch (const CLI::ParseError&) {

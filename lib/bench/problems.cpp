@@ -5,6 +5,7 @@
 
 #include "lazyboe/common/atomic_file.h"
 #include "lazyboe/common/error.h"
+#include "lazyboe/common/file_checks.h"
 #include "lazyboe/sim/random.h"
 
 namespace lazyboe {
@@ -48,6 +49,7 @@ std::vector<BenchProblem> sample_problems(const Simulator& sim, SimulatorWorkspa
 
 std::vector<BenchProblem> read_problems(const std::string& path, const Simulator& sim,
                                         SimulatorWorkspace& ws, const QueryDefaults& defaults) {
+  require_input_file(path, "problems");
   std::ifstream in(path);
   if (!in) fail(path, "cannot open file");
   std::vector<BenchProblem> problems;

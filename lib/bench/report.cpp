@@ -12,6 +12,7 @@
 #include "lazyboe/common/atomic_file.h"
 #include "lazyboe/common/error.h"
 #include "lazyboe/common/histogram.h"
+#include "lazyboe/common/numbers.h"
 #include "lazyboe/common/statistics.h"
 
 namespace lazyboe {
@@ -63,14 +64,10 @@ std::string number(double value, const char* format = "%.6g") {
 
 double parse_number(const std::string& text, const std::string& where, const std::string& column) {
   if (text.empty()) return std::numeric_limits<double>::quiet_NaN();
-  size_t used = 0;
+  // Plain decimal, finite, >= 0 (times, costs, budgets): "0x10", "inf" and "nan" are refused.
   double value = 0;
-  try {
-    value = std::stod(text, &used);
-  } catch (const std::exception&) {
-    used = 0;
-  }
-  if (used != text.size()) fail(where, column + ": expected a number, got '" + text + "'");
+  if (!parse_decimal(text, value) || value < 0)
+    fail(where, column + ": expected a finite number >= 0, got '" + text + "'");
   return value;
 }
 

@@ -1,8 +1,14 @@
 #include "lazyboe/bundle/bundle_file.h"
 
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+
+#include "lazyboe/bundle/bundle_check.h"
 #include "lazyboe/bundle/hdf5_handle.h"
 #include "lazyboe/common/atomic_file.h"
 #include "lazyboe/common/error.h"
+#include "lazyboe/common/hash.h"
 
 namespace lazyboe {
 namespace {
@@ -44,6 +50,31 @@ void check_size(const std::string& where, const std::string& field, size_t found
   if (found != expected)
     fail(where, "bundle." + field + ": " + str(found) + " values, expected " + expected_text +
                     " = " + str(expected));
+}
+
+// Real attributes: finite and non-negative (an empty bundle written from default settings has
+// zeros; the tools that use a setting check it against what they need).
+void check_header_values(const std::string& where, const BundleHeader& h) {
+  const std::pair<const char*, double> values[] = {{"min_duration", h.min_duration},
+                                                   {"max_duration", h.max_duration},
+                                                   {"knot_interval", h.knot_interval},
+                                                   {"velocity_scale", h.velocity_scale},
+                                                   {"limit_scale", h.limit_scale},
+                                                   {"control_rate", h.control_rate},
+                                                   {"sample_interval", h.sample_interval},
+                                                   {"design_theta", h.design_theta},
+                                                   {"simulated_seconds", h.simulated_seconds},
+                                                   {"wall_seconds", h.wall_seconds}};
+  for (const auto& [name, v] : values)
+    if (!(std::isfinite(v) && v >= 0))
+      fail(where, std::string("attribute ") + name + ": " + std::to_string(v) +
+                      ", expected a finite number >= 0");
+  for (const auto* bounds : {&h.region_lower, &h.region_upper})
+    for (double v : *bounds)
+      if (!(std::abs(v) <= 1e3))
+        fail(where, std::string("attribute ") +
+                        (bounds == &h.region_lower ? "region_lower" : "region_upper") + ": " +
+                        std::to_string(v) + " is outside [-1000, 1000]");
 }
 
 // ---- header <-> root attributes ----
@@ -144,6 +175,7 @@ BundleHeader read_header(const std::string& where, hid_t file, uint64_t* edges) 
   const uint64_t n = read_attr_u64(where, file, "edges");
   if (edges) *edges = n;
   check_header(where, "attribute ", h);
+  check_header_values(where, h);
   return h;
 }
 
@@ -165,22 +197,34 @@ uint64_t rows_of(const std::string& where, hid_t file, const char* name, uint64_
   return found[0];
 }
 
+// A dataset with its checksum: "fnv1a64:<16 hex digits>" of its raw (little-endian) bytes, as
+// the attribute `checksum` (the layout stays contiguous and mappable).
+template <class T>
+void write_checked(const std::string& where, hid_t file, const char* name,
+                   const std::vector<T>& data, const std::vector<uint64_t>& dims) {
+  h5::write_dataset(where, file, name, data, dims);
+  Fnv1a64 hash;
+  hash.update(data.data(), data.size() * sizeof(T));
+  h5::Dataset dset = h5::open_dataset(where, file, name);
+  h5::write_attr_string(where, dset, kChecksumAttribute, std::string(kChecksumPrefix) + hash.hex());
+}
+
 void write_edges(const std::string& tmp, hid_t file, const Bundle& b) {
   const uint64_t n = b.size(), dof = static_cast<uint64_t>(b.dof());
   const uint64_t k = b.knots.size() / dof, s = b.sample_q.size() / dof;
   h5::create_group(tmp, file, "/edges");
   h5::create_group(tmp, file, "/controls");
   h5::create_group(tmp, file, "/trajectory");
-  h5::write_dataset(tmp, file, ds::q0, b.q0, {n, dof});
-  h5::write_dataset(tmp, file, ds::qf, b.qf, {n, dof});
-  h5::write_dataset(tmp, file, ds::duration, b.duration, {n});
-  h5::write_dataset(tmp, file, ds::command_duration, b.command_duration, {n});
-  h5::write_dataset(tmp, file, ds::attempt, b.attempt, {n});
-  h5::write_dataset(tmp, file, ds::knot_offset, b.knot_offset, {n + 1});
-  h5::write_dataset(tmp, file, ds::sample_offset, b.sample_offset, {n + 1});
-  h5::write_dataset(tmp, file, ds::knots, b.knots, {k, dof});
-  h5::write_dataset(tmp, file, ds::sample_q, b.sample_q, {s, dof});
-  h5::write_dataset(tmp, file, ds::sample_dq, b.sample_dq, {s, dof});
+  write_checked(tmp, file, ds::q0, b.q0, {n, dof});
+  write_checked(tmp, file, ds::qf, b.qf, {n, dof});
+  write_checked(tmp, file, ds::duration, b.duration, {n});
+  write_checked(tmp, file, ds::command_duration, b.command_duration, {n});
+  write_checked(tmp, file, ds::attempt, b.attempt, {n});
+  write_checked(tmp, file, ds::knot_offset, b.knot_offset, {n + 1});
+  write_checked(tmp, file, ds::sample_offset, b.sample_offset, {n + 1});
+  write_checked(tmp, file, ds::knots, b.knots, {k, dof});
+  write_checked(tmp, file, ds::sample_q, b.sample_q, {s, dof});
+  write_checked(tmp, file, ds::sample_dq, b.sample_dq, {s, dof});
 }
 
 void write_perturbation(const std::string& tmp, hid_t file, const Perturbation& p, uint64_t n) {
@@ -194,18 +238,60 @@ void write_perturbation(const std::string& tmp, hid_t file, const Perturbation& 
   h5::write_attr_string(
       tmp, g, "distribution",
       "start + d, d = r u: u uniform on the unit sphere, r uniform in (0, theta]");
-  h5::write_dataset(tmp, file, ds::pert_done, p.done, {n});
-  h5::write_dataset(tmp, file, ds::pert_valid, p.valid, {n});
-  h5::write_dataset(tmp, file, ds::pert_lazy, p.lazy, {n});
-  h5::write_dataset(tmp, file, ds::pert_collision, p.collision, {n});
-  h5::write_dataset(tmp, file, ds::pert_max_error, p.max_error, {n});
-  h5::write_dataset(tmp, file, ds::p_lazy_prop, p.p_lazy_prop, {n});
-  h5::write_dataset(tmp, file, ds::p_collision, p.p_collision, {n});
+  write_checked(tmp, file, ds::pert_done, p.done, {n});
+  write_checked(tmp, file, ds::pert_valid, p.valid, {n});
+  write_checked(tmp, file, ds::pert_lazy, p.lazy, {n});
+  write_checked(tmp, file, ds::pert_collision, p.collision, {n});
+  write_checked(tmp, file, ds::pert_max_error, p.max_error, {n});
+  write_checked(tmp, file, ds::p_lazy_prop, p.p_lazy_prop, {n});
+  write_checked(tmp, file, ds::p_collision, p.p_collision, {n});
   if (p.has_transfer) {
-    h5::write_dataset(tmp, file, ds::transfer_lazy, p.transfer_lazy, {n});
-    h5::write_dataset(tmp, file, ds::transfer_max_error, p.transfer_max_error, {n});
-    h5::write_dataset(tmp, file, ds::p_lazy_prop_transfer, p.p_lazy_prop_transfer, {n});
+    write_checked(tmp, file, ds::transfer_lazy, p.transfer_lazy, {n});
+    write_checked(tmp, file, ds::transfer_max_error, p.transfer_max_error, {n});
+    write_checked(tmp, file, ds::p_lazy_prop_transfer, p.p_lazy_prop_transfer, {n});
   }
+}
+
+// The dataset bytes of the file, to size its memory image at once.
+uint64_t payload_bytes(const Bundle& b) {
+  const Perturbation& p = b.perturbation;
+  return 8 * (b.q0.size() + b.qf.size() + b.duration.size() + b.command_duration.size() +
+              b.attempt.size() + b.knot_offset.size() + b.sample_offset.size() + b.knots.size()) +
+         4 * (b.sample_q.size() + b.sample_dq.size()) +
+         (p.present ? 8 * b.size() * (p.has_transfer ? 10 : 7) : 0);
+}
+
+BundleArrays arrays_of(const Bundle& b, uint64_t knot_rows, uint64_t sample_rows) {
+  BundleArrays a;
+  a.edges = b.size();
+  a.dof = static_cast<uint64_t>(b.dof());
+  a.knot_rows = knot_rows;
+  a.sample_rows = sample_rows;
+  a.q0 = b.q0.data();
+  a.qf = b.qf.data();
+  a.duration = b.duration.data();
+  a.command_duration = b.command_duration.data();
+  a.knot_offset = b.knot_offset.data();
+  a.sample_offset = b.sample_offset.data();
+  a.knots = b.knots.data();
+  a.sample_q = b.sample_q.data();
+  a.sample_dq = b.sample_dq.data();
+  const Perturbation& p = b.perturbation;
+  if (!p.present) return a;
+  a.perturbations = p.perturbations;
+  a.done = p.done.data();
+  a.valid = p.valid.data();
+  a.lazy = p.lazy.data();
+  a.collision = p.collision.data();
+  a.max_error = p.max_error.data();
+  a.p_lazy_prop = p.p_lazy_prop.data();
+  a.p_collision = p.p_collision.data();
+  if (p.has_transfer) {
+    a.transfer_lazy = p.transfer_lazy.data();
+    a.transfer_max_error = p.transfer_max_error.data();
+    a.p_lazy_prop_transfer = p.p_lazy_prop_transfer.data();
+  }
+  return a;
 }
 
 }  // namespace
@@ -256,14 +342,15 @@ void check_bundle(const Bundle& b, const std::string& where) {
 void write_bundle(const std::string& path, const Bundle& b) {
   check_bundle(b, path);
   AtomicFile out(path, AtomicFile::Writer::External);
-  const std::string& tmp = out.temp_path();
-  {
-    h5::File file = h5::create_file(tmp);
-    write_header(tmp, file, b.header, b.size());
-    write_edges(tmp, file, b);
-    if (b.perturbation.present) write_perturbation(tmp, file, b.perturbation, b.size());
-    h5::close_file(tmp, file);
-  }
+  // The file is composed in memory and written with plain writes, so that a full disk is one
+  // clear error naming `path` (HDF5 itself, failing a write, leaves a state that crashes at exit).
+  h5::File file = h5::create_memory_file(path, payload_bytes(b) + (1 << 20));
+  write_header(path, file, b.header, b.size());
+  write_edges(path, file, b);
+  if (b.perturbation.present) write_perturbation(path, file, b.perturbation, b.size());
+  const std::vector<unsigned char> image = h5::memory_file_image(path, file);
+  file.close();
+  out.write_all(image.data(), image.size());
   out.commit();
 }
 
@@ -337,6 +424,7 @@ Bundle read_bundle(const std::string& path) {
       p.p_lazy_prop_transfer = h5::read_dataset<double>(path, file, ds::p_lazy_prop_transfer, {n});
     }
   }
+  check_bundle_arrays(arrays_of(b, k, s), path);
   return b;
 }
 
@@ -378,6 +466,68 @@ DatasetLocation dataset_location(const std::string& where, hid_t file, const std
 DatasetLocation dataset_location(const std::string& path, const std::string& dataset) {
   h5::File file = h5::open_file(path);
   return dataset_location(path, file, dataset);
+}
+
+namespace {
+
+// FNV-1a 64 of a dataset's bytes as they lie in the file.
+std::string file_bytes_checksum(const std::string& path, const DatasetLocation& loc) {
+  Fnv1a64 hash;
+  std::ifstream in(path, std::ios::binary);
+  in.seekg(static_cast<std::streamoff>(loc.file_offset));
+  std::vector<char> buffer(1 << 20);
+  for (uint64_t left = loc.bytes; left > 0;) {
+    const size_t chunk = static_cast<size_t>(std::min<uint64_t>(left, buffer.size()));
+    if (!in.read(buffer.data(), static_cast<std::streamsize>(chunk)))
+      fail(path, "cannot read the file (truncated?)");
+    hash.update(buffer.data(), chunk);
+    left -= chunk;
+  }
+  return std::string(kChecksumPrefix) + hash.hex();
+}
+
+}  // namespace
+
+std::vector<DatasetVerification> verify_bundle_checksums(const std::string& path) {
+  h5::File file = h5::open_file(path);
+  std::vector<DatasetVerification> out;
+  for (const char* name : {ds::q0,
+                           ds::qf,
+                           ds::duration,
+                           ds::command_duration,
+                           ds::attempt,
+                           ds::knot_offset,
+                           ds::sample_offset,
+                           ds::knots,
+                           ds::sample_q,
+                           ds::sample_dq,
+                           ds::pert_done,
+                           ds::pert_valid,
+                           ds::pert_lazy,
+                           ds::pert_collision,
+                           ds::pert_max_error,
+                           ds::p_lazy_prop,
+                           ds::p_collision,
+                           ds::transfer_lazy,
+                           ds::transfer_max_error,
+                           ds::p_lazy_prop_transfer}) {
+    if (!h5::exists(file, name)) continue;  // optional ones; a missing required one: read_bundle
+    DatasetVerification v;
+    v.dataset = name;
+    h5::Dataset dset = h5::open_dataset(path, file, name);
+    if (!h5::has_attribute(dset, kChecksumAttribute)) {
+      v.status = DatasetVerification::Status::NoChecksum;
+    } else {
+      v.stored = h5::read_attr_string(path, dset, kChecksumAttribute);
+      const DatasetLocation loc = dataset_location(path, file, name);
+      if (!loc.contiguous) fail(path, std::string(name) + ": not contiguous, cannot verify");
+      v.computed = file_bytes_checksum(path, loc);
+      v.status = v.stored == v.computed ? DatasetVerification::Status::Verified
+                                        : DatasetVerification::Status::Mismatch;
+    }
+    out.push_back(v);
+  }
+  return out;
 }
 
 }  // namespace lazyboe

@@ -8,6 +8,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "lazyboe/bundle/bundle.h"
 
@@ -72,6 +73,19 @@ struct DatasetLocation {
   uint64_t bytes = 0;
 };
 DatasetLocation dataset_location(const std::string& path, const std::string& dataset);
+
+// Every dataset carries the attribute `checksum` = "fnv1a64:" + 16 hex digits, the FNV-1a 64 of
+// its raw bytes, computed when written. Verification rereads the bytes from the file.
+constexpr const char* kChecksumAttribute = "checksum";
+constexpr const char* kChecksumPrefix = "fnv1a64:";
+struct DatasetVerification {
+  enum class Status { Verified, Mismatch, NoChecksum };  // NoChecksum: written before checksums
+  std::string dataset;
+  Status status = Status::NoChecksum;
+  std::string stored, computed;
+};
+// Every dataset of the bundle present in the file, in the order of schemas/bundle.md.
+std::vector<DatasetVerification> verify_bundle_checksums(const std::string& path);
 // (The same on an already open HDF5 file is in hdf5_handle.h, which is not installed.)
 
 }  // namespace lazyboe

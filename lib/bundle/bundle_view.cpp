@@ -9,6 +9,7 @@
 #include <cstring>
 #include <utility>
 
+#include "lazyboe/bundle/bundle_check.h"
 #include "lazyboe/bundle/bundle_file.h"
 #include "lazyboe/bundle/hdf5_handle.h"
 #include "lazyboe/common/error.h"
@@ -86,6 +87,13 @@ BundleView BundleView::open(const std::string& path, bool allow_mmap) {
   if (knot_shape.size() != 2 || knot_shape[1] != dof)
     fail(path, std::string(ds::knots) + ": expected K x dof");
   v.knots_ = v.attach<double>(file, ds::knots, knot_shape, allow_mmap);
+  // The sample offsets are checked like every reader checks them (the samples themselves are
+  // never read by the planners: read_bundle and --verify check them).
+  const std::vector<uint64_t> sample_shape = h5::dataset_shape(path, file, ds::sample_q);
+  if (sample_shape.size() != 2 || sample_shape[1] != dof)
+    fail(path, std::string(ds::sample_q) + ": expected S x dof");
+  const uint64_t sample_rows = sample_shape[0];
+  const uint64_t* sample_offset = v.attach<uint64_t>(file, ds::sample_offset, {n + 1}, allow_mmap);
   v.check_knot_ranges(knot_shape[0]);
   if (h5::exists(file, ds::perturbation)) {
     h5::Group g(H5Gopen2(file, ds::perturbation, H5P_DEFAULT));
@@ -102,6 +110,7 @@ BundleView BundleView::open(const std::string& path, bool allow_mmap) {
       }
     }
   }
+  v.check_values(knot_shape[0], sample_rows, sample_offset);
   return v;
 }
 
@@ -122,6 +131,8 @@ BundleView BundleView::from_memory(std::shared_ptr<const Bundle> bundle, std::st
   v.knot_offset_ = b.knot_offset.data();
   v.knots_ = b.knots.data();
   v.check_knot_ranges(b.knots.size() / static_cast<size_t>(b.dof()));
+  v.check_values(b.knots.size() / static_cast<size_t>(b.dof()),
+                 b.sample_q.size() / static_cast<size_t>(b.dof()), b.sample_offset.data());
   const Perturbation& p = b.perturbation;
   if (p.present && v.use_perturbation(p.complete)) {
     v.perturbation_theta_ = p.theta;
@@ -144,6 +155,31 @@ void BundleView::check_knot_ranges(uint64_t knot_rows) const {
            std::string(ds::knot_offset) + ": edge " + std::to_string(e) + " has a bad knot range");
     }
   }
+}
+
+// The checks every reader runs (bundle_check.h) on what the view reads, in one pass.
+void BundleView::check_values(uint64_t knot_rows, uint64_t sample_rows,
+                              const uint64_t* sample_offset) const {
+  BundleArrays a;
+  a.edges = edges_;
+  a.dof = static_cast<uint64_t>(dof());
+  a.knot_rows = knot_rows;
+  a.sample_rows = sample_rows;
+  a.q0 = q0_;
+  a.qf = qf_;
+  a.duration = duration_;
+  a.command_duration = command_duration_;
+  a.knot_offset = knot_offset_;
+  a.sample_offset = sample_offset;
+  a.knots = knots_;
+  a.p_lazy_prop = p_lazy_prop_;
+  a.p_collision = p_collision_;
+  a.p_lazy_prop_transfer = p_lazy_prop_transfer_;
+  a.transfer_max_error = transfer_max_error_;
+  check_bundle_arrays(a, path_);
+  if (has_perturbation_ && !(perturbation_theta_ > 0 && perturbation_theta_ <= 1e3))
+    fail(path_, std::string(ds::perturbation) + ": attribute theta: " +
+                    std::to_string(perturbation_theta_) + ", expected a value in (0, 1000]");
 }
 
 // Only a finished analysis is used; an unfinished one is ignored with a warning.

@@ -70,6 +70,7 @@ class BundleView {
                   bool allow_mmap);
   // What both ways of making a view check and decide once the arrays are attached.
   void check_knot_ranges(uint64_t knot_rows) const;
+  void check_values(uint64_t knot_rows, uint64_t sample_rows, const uint64_t* sample_offset) const;
   bool use_perturbation(bool complete);
 
   std::string path_;

@@ -4,6 +4,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <limits>
@@ -240,6 +241,29 @@ File create_file(const std::string& path) {
   File file(H5Fcreate(path.c_str(), H5F_ACC_TRUNC, fcpl, fapl));
   if (!file.valid()) fail_hdf5(path, "cannot create the file");
   return file;
+}
+
+File create_memory_file(const std::string& name, uint64_t expected_bytes) {
+  quiet();
+  PropList fcpl = create_plist(H5P_FILE_CREATE);
+  PropList fapl = create_plist(H5P_FILE_ACCESS);
+  const size_t increment = static_cast<size_t>(std::max<uint64_t>(expected_bytes, 1 << 20));
+  if (H5Pset_obj_track_times(fcpl, 0) < 0 || H5Pset_fclose_degree(fapl, H5F_CLOSE_STRONG) < 0 ||
+      H5Pset_fapl_core(fapl, increment, 0) < 0)
+    fail_hdf5(name, "cannot set up the HDF5 file properties");
+  File file(H5Fcreate(name.c_str(), H5F_ACC_TRUNC, fcpl, fapl));
+  if (!file.valid()) fail_hdf5(name, "cannot create the file in memory");
+  return file;
+}
+
+std::vector<unsigned char> memory_file_image(const std::string& where, File& file) {
+  if (H5Fflush(file, H5F_SCOPE_GLOBAL) < 0) fail_hdf5(where, "cannot complete the file in memory");
+  const ssize_t size = H5Fget_file_image(file, nullptr, 0);
+  if (size < 0) fail_hdf5(where, "cannot read the file size");
+  std::vector<unsigned char> image(static_cast<size_t>(size));
+  if (H5Fget_file_image(file, image.data(), image.size()) != size)
+    fail_hdf5(where, "cannot copy the file image out of memory");
+  return image;
 }
 
 namespace {

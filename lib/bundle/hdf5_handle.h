@@ -70,6 +70,14 @@ using PropList = Handle<H5Pclose>;
 // Creates (truncating) a file with the default (1.8-compatible) format. Objects created
 // through these helpers do not record modification times, so equal content gives equal bytes.
 File create_file(const std::string& path);
+// The same file held in memory only (HDF5's core driver, no backing store): nothing touches the
+// disk, so a full disk cannot fail inside HDF5 (where a failed write leaves the library in a
+// state that crashes at exit). `expected_bytes` sizes the first allocation. `name` only labels
+// the file.
+File create_memory_file(const std::string& name, uint64_t expected_bytes);
+// The bytes of a memory file made by create_memory_file, as a complete HDF5 file (as if it
+// were closed: HDF5 clears the open-for-writing flag in the copy).
+std::vector<unsigned char> memory_file_image(const std::string& where, File& file);
 // Opens read-only; "no such file", "not an HDF5 file" and the like name the path.
 File open_file(const std::string& path);
 // Opens read-write (tests and repair tools; the bundle writer never modifies in place).

@@ -133,6 +133,23 @@ void print_build_summary(const BundleHeader& h, std::FILE* out) {
                h.wall_seconds > 0 ? h.valid / h.wall_seconds : 0.0);
 }
 
+std::string checksum_summary(const std::vector<DatasetVerification>& checks) {
+  size_t verified = 0, missing = 0;
+  std::string bad;
+  for (const DatasetVerification& v : checks) {
+    if (v.status == DatasetVerification::Status::Verified) ++verified;
+    if (v.status == DatasetVerification::Status::NoChecksum) ++missing;
+    if (v.status == DatasetVerification::Status::Mismatch)
+      bad += (bad.empty() ? "" : ", ") + v.dataset;
+  }
+  if (!bad.empty()) return "MISMATCH in " + bad + ": the file is damaged";
+  if (missing == checks.size()) return "none (written before checksums existed)";
+  if (missing > 0)
+    return std::to_string(verified) + " of " + std::to_string(checks.size()) +
+           " datasets verify, " + std::to_string(missing) + " have no checksum";
+  return "all " + std::to_string(verified) + " datasets verify";
+}
+
 void print_inspection(const std::string& path, std::FILE* out) {
   const Bundle b = read_bundle(path);
   const BundleHeader& h = b.header;
@@ -159,6 +176,7 @@ void print_inspection(const std::string& path, std::FILE* out) {
   for (int i = 0; i < n; ++i) std::fprintf(out, " [%g, %g]", h.region_lower[i], h.region_upper[i]);
   std::fprintf(out, "\n");
   print_build_summary(h, out);
+  std::fprintf(out, "  checksums: %s\n", checksum_summary(verify_bundle_checksums(path)).c_str());
   if (N == 0) return;
 
   std::vector<double> displacement(N);

@@ -4,10 +4,16 @@
 
 #include <cstdio>
 #include <string>
+#include <vector>
 
 #include "lazyboe/bundle/bundle.h"
+#include "lazyboe/bundle/bundle_file.h"
 
 namespace lazyboe {
+
+// One line on a bundle's checksums: "all 17 datasets verify", "MISMATCH in /edges/q0: ...",
+// "none (written before checksums existed)".
+std::string checksum_summary(const std::vector<DatasetVerification>& checks);
 
 void print_inspection(const std::string& path, std::FILE* out);
 

@@ -1,5 +1,9 @@
 #include "lazyboe/bundle/scene.h"
 
+#include <cerrno>
+#include <cstring>
+#include <filesystem>
+
 #include "lazyboe/common/error.h"
 #include "lazyboe/common/hash.h"
 
@@ -11,9 +15,28 @@ std::string robot_identity(const RobotModel& robot) {
 
 std::string environment_identity(const Environment& env) { return hash_files({env.path}); }
 
+namespace {
+
+// A file named in the bundle that is no longer there: say where the path came from and how to
+// give it instead.
+void require_recorded_file(const std::string& path, const char* what, const char* option) {
+  if (std::filesystem::exists(path)) return;
+  fail(path, std::string("cannot open the ") + what + " recorded in the bundle (" +
+                 std::strerror(ENOENT) + "; relative paths are taken from the current directory" +
+                 "): moved? give it with " + option + " FILE");
+}
+
+}  // namespace
+
 BundleScene load_bundle_scene(const BundleHeader& h, std::string robot_path, std::string env_path) {
-  if (robot_path.empty()) robot_path = h.robot_config;
-  if (env_path.empty()) env_path = h.env_file;
+  if (robot_path.empty()) {
+    robot_path = h.robot_config;
+    require_recorded_file(robot_path, "robot config", "--robot");
+  }
+  if (env_path.empty()) {
+    env_path = h.env_file;
+    require_recorded_file(env_path, "environment", "--env");
+  }
   BundleScene scene{load_robot(robot_path), load_environment(env_path)};
   const std::string robot_hash = robot_identity(scene.robot);
   if (robot_hash != h.robot_hash) {

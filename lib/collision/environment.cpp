@@ -3,8 +3,20 @@
 #include <set>
 
 #include "lazyboe/common/json_fields.h"
+#include "lazyboe/common/numbers.h"
 
 namespace lazyboe {
+namespace {
+
+// Accepted ranges (schemas/environment.schema.json and docs/reliability.md list the same): a
+// scene of at most a few hundred metres around the robot, so that no size or distance
+// overflows the collision checker's arithmetic.
+const RealRange kExtent{0, 100, true};  // box sizes, radii, lengths, m
+const RealRange kPosition{-100, 100};   // m
+const RealRange kAngle{-100, 100};      // rad
+const RealRange kQuaternionComponent{-1e3, 1e3};
+
+}  // namespace
 
 std::string default_environment_path() { return data_dir() + "/environments/table.json"; }
 
@@ -29,30 +41,31 @@ Environment load_environment(const std::string& path) {
     if (type == "box") {
       item.allow_only({"name", "type", "size", "position", "rpy", "quaternion", "allowed_links"});
       o.shape.type = ShapeType::Box;
-      o.shape.size = item.at("size").vec3();
-      if (!(o.shape.size.minCoeff() > 0)) item.at("size").fail("every extent must be > 0");
+      o.shape.size = item.at("size").vec3_in(kExtent, " m");
     } else if (type == "sphere") {
       item.allow_only({"name", "type", "radius", "position", "allowed_links"});
       o.shape.type = ShapeType::Sphere;
-      o.shape.radius = item.at("radius").positive();
+      o.shape.radius = item.at("radius").number_in(kExtent, " m");
     } else if (type == "cylinder" || type == "capsule") {
       item.allow_only(
           {"name", "type", "radius", "length", "position", "rpy", "quaternion", "allowed_links"});
       o.shape.type = type == "cylinder" ? ShapeType::Cylinder : ShapeType::Capsule;
-      o.shape.radius = item.at("radius").positive();
-      o.shape.length = item.at("length").positive();
+      o.shape.radius = item.at("radius").number_in(kExtent, " m");
+      o.shape.length = item.at("length").number_in(kExtent, " m");
     } else {
       item.at("type").fail("unknown object type '" + type +
                            "' (expected box, sphere, cylinder or capsule)");
     }
-    o.pose.p = item.at("position").vec3();
+    o.pose.p = item.at("position").vec3_in(kPosition, " m");
     if (item.has("rpy") && item.has("quaternion")) item.fail("give rpy or quaternion, not both");
     if (item.has("rpy")) {
-      const Eigen::Vector3d rpy = item.at("rpy").vec3();
+      const Eigen::Vector3d rpy = item.at("rpy").vec3_in(kAngle, " rad");
       o.pose.R = rotation_from_rpy(rpy.x(), rpy.y(), rpy.z());
     } else if (item.has("quaternion")) {
-      const std::vector<double> q = item.at("quaternion").numbers();
-      if (q.size() != 4) item.at("quaternion").fail("expected 4 numbers [w, x, y, z]");
+      const std::vector<JsonField> items = item.at("quaternion").items();
+      if (items.size() != 4) item.at("quaternion").fail("expected 4 numbers [w, x, y, z]");
+      std::vector<double> q;
+      for (const JsonField& c : items) q.push_back(c.number_in(kQuaternionComponent));
       Eigen::Quaterniond quat(q[0], q[1], q[2], q[3]);
       if (!(quat.norm() > 1e-9)) item.at("quaternion").fail("must not be zero");
       o.pose.R = quat.normalized().toRotationMatrix();

@@ -3,6 +3,7 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -30,6 +31,8 @@ void fsync_path(const std::string& path, bool directory) {
 
 AtomicFile::AtomicFile(const std::string& path, Writer writer)
     : path_(path), temp_path_(path + ".tmp." + std::to_string(::getpid())) {
+  // Said now, not after all the work when the rename fails.
+  if (std::filesystem::is_directory(path_)) fail(path_, "cannot write: is a directory, not a file");
   if (writer == Writer::External) return;
   errno = 0;
   out_.open(temp_path_, std::ios::out | std::ios::trunc);
@@ -40,6 +43,31 @@ AtomicFile::~AtomicFile() {
   if (committed_) return;
   if (out_.is_open()) out_.close();
   ::unlink(temp_path_.c_str());
+}
+
+void AtomicFile::write_all(const void* data, size_t bytes) {
+  const int fd = ::open(temp_path_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) fail(path_, "cannot write: " + last_error());
+  const char* p = static_cast<const char*>(data);
+  size_t left = bytes;
+  while (left > 0) {
+    const ssize_t n = ::write(fd, p, std::min<size_t>(left, size_t{1} << 30));
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      const std::string reason = n < 0 ? last_error() : "nothing written";
+      ::close(fd);
+      ::unlink(temp_path_.c_str());
+      fail(path_, "cannot write: " + reason + " (" + std::to_string(bytes) + " bytes to write, " +
+                      std::to_string(bytes - left) + " written)");
+    }
+    p += n;
+    left -= static_cast<size_t>(n);
+  }
+  if (::close(fd) != 0) {
+    const std::string reason = last_error();
+    ::unlink(temp_path_.c_str());
+    fail(path_, "cannot write: " + reason);
+  }
 }
 
 void AtomicFile::commit() {

@@ -28,6 +28,10 @@ class AtomicFile {
   const std::string& path() const { return path_; }
   const std::string& temp_path() const { return temp_path_; }
 
+  // Writer::External: writes `bytes` bytes as the whole temporary file. A short write (a full
+  // disk, a file-size limit) throws Error("<path>: cannot write: <reason>") and removes it.
+  void write_all(const void* data, size_t bytes);
+
   // Flushes, fsyncs and renames the temporary file over `path`, then fsyncs the directory
   // (best effort: the new file is in place already). On failure removes the temporary file,
   // leaves `path` untouched and throws Error naming `path`.

@@ -10,8 +10,17 @@
 
 namespace lazyboe {
 
-// Parses a whole JSON file; a syntax error names the line and column.
+struct RealRange;
+
+// Parses a whole JSON file; a syntax error or a number out of range names the line and column,
+// a key repeated within one object (which JSON parsers resolve differently) names the key and
+// where it is. A directory or a missing file is named as such.
 nlohmann::json load_json_file(const std::string& path);
+
+// The same for text held in memory; `where` starts the messages ("line 3"). With
+// `with_position`, syntax errors add ":line:column" to `where`.
+nlohmann::json parse_json_text(const std::string& text, const std::string& where,
+                               bool with_position);
 
 // A view of one JSON value with the file and path it came from.
 class JsonField {
@@ -29,6 +38,9 @@ class JsonField {
   void allow_only(const std::vector<std::string>& keys) const;
 
   double number() const;  // finite
+  // A finite number within `range`; the message names the range (and `unit`, e.g. " m").
+  double number_in(const RealRange& range, const std::string& unit = "") const;
+  Eigen::Vector3d vec3_in(const RealRange& range, const std::string& unit = "") const;
   double number_at_least(double min) const;
   double positive() const;
   long integer() const;

@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "lazyboe/common/error.h"
+#include "lazyboe/common/file_checks.h"
 
 namespace lazyboe {
 namespace {
@@ -43,8 +44,9 @@ std::vector<std::string> numbered_columns(const std::string& prefix, int n) {
   return out;
 }
 
-CsvTable read_numeric_csv(const std::string& path,
-                          const std::vector<std::string>& expected_header) {
+CsvTable read_numeric_csv(const std::string& path, const std::vector<std::string>& expected_header,
+                          const RealRange& range) {
+  require_input_file(path);
   std::ifstream in(path);
   if (!in) fail(path, "cannot open file");
   CsvTable table;
@@ -70,18 +72,7 @@ CsvTable read_numeric_csv(const std::string& path,
     }
     std::vector<double> row(cells.size());
     for (size_t c = 0; c < cells.size(); ++c) {
-      const char* text = cells[c].c_str();
-      char* end = nullptr;
-      errno = 0;
-      const double v = std::strtod(text, &end);
-      if (cells[c].empty() || end == text || *end != '\0') {
-        fail(where, "column '" + expected_header[c] + "': not a number ('" + cells[c] + "')");
-      }
-      if (!std::isfinite(v) || errno == ERANGE) {
-        fail(where,
-             "column '" + expected_header[c] + "': value must be finite ('" + cells[c] + "')");
-      }
-      row[c] = v;
+      row[c] = parse_real_in(cells[c], range, where + ": column '" + expected_header[c] + "'");
     }
     table.rows.push_back(std::move(row));
     table.line.push_back(line_no);

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "lazyboe/common/atomic_file.h"
+#include "lazyboe/common/numbers.h"
 
 namespace lazyboe {
 
@@ -15,8 +16,10 @@ struct CsvTable {
   std::vector<int> line;  // source line of each row, for messages
 };
 
-// Reads a CSV whose header must equal `expected_header` exactly.
-CsvTable read_numeric_csv(const std::string& path, const std::vector<std::string>& expected_header);
+// Reads a CSV whose header must equal `expected_header` exactly. Every cell is a plain decimal
+// number ("0x10", "inf", "1e400" are refused) within `range`.
+CsvTable read_numeric_csv(const std::string& path, const std::vector<std::string>& expected_header,
+                          const RealRange& range = {-1e9, 1e9});
 
 // Column names like q1..qn.
 std::vector<std::string> numbered_columns(const std::string& prefix, int n);

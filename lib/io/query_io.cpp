@@ -4,6 +4,7 @@
 
 #include "lazyboe/common/error.h"
 #include "lazyboe/common/json_fields.h"
+#include "lazyboe/common/numbers.h"
 #include "lazyboe/io/csv.h"
 
 namespace lazyboe {
@@ -64,8 +65,9 @@ void parse_position_goal(const JsonField& goal, const RobotModel& robot, const Q
                          Goal& g) {
   goal.allow_only({"position", "tolerance", "link"});
   g.kind = Goal::Kind::Position;
-  g.position = goal.at("position").vec3();
-  g.tolerance = goal.has("tolerance") ? goal.at("tolerance").positive() : d.position_tolerance;
+  g.position = goal.at("position").vec3_in({-100, 100}, " m");
+  g.tolerance = goal.has("tolerance") ? goal.at("tolerance").number_in({0, 100, true}, " m")
+                                      : d.position_tolerance;
   const std::string link =
       goal.has("link") ? goal.at("link").string() : robot.links[robot.tip_link()].name;
   g.link = robot.link_index(link);
@@ -77,7 +79,8 @@ void parse_goal(const JsonField& goal, const RobotModel& robot, const QueryDefau
     goal.allow_only({"q", "tolerance"});
     g.kind = Goal::Kind::Joint;
     g.q = joint_vector(goal.at("q"), robot.dof);
-    g.tolerance = goal.has("tolerance") ? goal.at("tolerance").positive() : d.joint_tolerance;
+    g.tolerance = goal.has("tolerance") ? goal.at("tolerance").number_in({0, 1e3, true}, " rad")
+                                        : d.joint_tolerance;
   } else if (goal.has("position")) {
     parse_position_goal(goal, robot, d, g);
   } else {
@@ -101,12 +104,7 @@ const std::vector<std::string>& query_fields() {
 Query parse_query(const std::string& text, int line, const RobotModel& robot, const Simulator& sim,
                   SimulatorWorkspace& ws, const QueryDefaults& d, std::string& id_out) {
   const std::string where = "line " + std::to_string(line);
-  nlohmann::json doc;
-  try {
-    doc = nlohmann::json::parse(text);
-  } catch (const nlohmann::json::parse_error&) {
-    fail(where, "not valid JSON");
-  }
+  const nlohmann::json doc = parse_json_text(text, where, false);
   if (!doc.is_object()) fail(where, "expected a JSON object");
   if (doc.contains("id") && doc["id"].is_string()) id_out = doc["id"].get<std::string>();
   const JsonField root(doc, where, "");
@@ -116,7 +114,9 @@ Query parse_query(const std::string& text, int line, const RobotModel& robot, co
   q.id = root.at("id").string();
   parse_planner(root, q);
   PlanningProblem& p = q.problem;
-  p.termination.budget = root.has("budget") ? root.at("budget").positive() : d.budget;
+  p.termination.budget = root.has("budget")
+                             ? root.at("budget").number_in({0, kMaxBudgetSeconds, true}, " s")
+                             : d.budget;
   if (root.has("stop_at_first")) p.termination.stop_at_first = root.at("stop_at_first").boolean();
   p.seed = root.has("seed") ? static_cast<uint64_t>(root.at("seed").integer()) : 1;
   if (root.has("seed") && root.at("seed").integer() < 0) root.at("seed").fail("must be >= 0");

@@ -55,7 +55,8 @@ ProblemIssue find_problem_issue(const Simulator& sim, SimulatorWorkspace& ws,
   }
   if (!(g.tolerance > 0)) return {"goal.tolerance", "must be > 0"};
   if (g.contains(robot, ws.robot, p.start)) return {"goal", "the start already satisfies the goal"};
-  if (!(p.termination.budget > 0)) return {"budget", "must be > 0"};
+  if (!(p.termination.budget > 0 && p.termination.budget <= kMaxBudgetSeconds))
+    return {"budget", "must be in (0, 1000000] s"};
   return {};
 }
 

@@ -31,8 +31,12 @@ struct Goal {
 
 // When a solve stops: its wall-clock budget has run out or, with stop_at_first, it has found a
 // solution. (RRT, OMPL's RRT and KPIECE always stop at their first solution.)
+// The longest accepted budget (about 11.6 days): far below where the deadline's nanosecond
+// clock would overflow (about 9.2e9 s).
+constexpr double kMaxBudgetSeconds = 1e6;
+
 struct Termination {
-  double budget = 5.0;  // wall-clock seconds, from the start of the solve
+  double budget = 5.0;  // wall-clock seconds, from the start of the solve, (0, kMaxBudgetSeconds]
   bool stop_at_first = false;
 };
 

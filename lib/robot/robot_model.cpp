@@ -17,9 +17,12 @@
 #include <sstream>
 
 #include "lazyboe/common/error.h"
+#include "lazyboe/common/file_checks.h"
 #include "lazyboe/common/json_fields.h"
+#include "lazyboe/common/numbers.h"
 #include "lazyboe/robot/dynamics.h"
 #include "lazyboe/robot/kinematics.h"
+#include "lazyboe/robot/urdf_check.h"
 
 namespace lazyboe {
 namespace {
@@ -43,6 +46,7 @@ Pose pose_from_urdf(const urdf::Pose& pose) {
 }
 
 urdf::ModelInterfaceSharedPtr parse_urdf_file(const std::string& path) {
+  require_input_file(path, "URDF file");
   std::ifstream in(path);
   if (!in) fail(path, "cannot open URDF file");
   std::stringstream buffer;
@@ -54,6 +58,7 @@ urdf::ModelInterfaceSharedPtr parse_urdf_file(const std::string& path) {
     fail(path + ":" + std::to_string(xml.ErrorRow()) + ":" + std::to_string(xml.ErrorCol()),
          std::string("malformed XML (") + xml.ErrorDesc() + ")");
   }
+  check_urdf_values(buffer.str(), path);
   CapturingOutputHandler handler;
   console_bridge::useOutputHandler(&handler);
   urdf::ModelInterfaceSharedPtr urdf_model = urdf::parseURDF(buffer.str());
@@ -88,6 +93,20 @@ void check_inertial(const std::string& urdf_path, const urdf::Link& link) {
   }
 }
 
+// The accepted ranges of the robot config's numbers (schemas/robot-config.schema.json and
+// docs/reliability.md list the same): physical bounds wide enough for any real arm, narrow
+// enough that the dynamics cannot overflow.
+const RealRange kFrictionCoefficient{-1e6, 1e6};
+const RealRange kFrictionTorque{0, 1e6};
+const RealRange kSmoothingVelocity{0, 1e3, true};
+const RealRange kMaxAcceleration{0, 1e6, true};
+const RealRange kMaxJerk{0, 1e9, true};
+const RealRange kMaxTorqueRate{0, 1e9, true};
+const RealRange kGain{0, 1e6};
+const RealRange kCollisionMargin{0, 1};
+const RealRange kGravity{-1e3, 1e3};
+const RealRange kRegionBound{-1e3, 1e3};
+
 Friction read_friction(const JsonField& f) {
   Friction friction;
   const std::string model = f.at("model").string();
@@ -96,16 +115,16 @@ Friction read_friction(const JsonField& f) {
   } else if (model == "sigmoid") {
     f.allow_only({"model", "fi1", "fi2", "fi3"});
     friction.model = FrictionModel::Sigmoid;
-    friction.a = f.at("fi1").number();
-    friction.b = f.at("fi2").number();
-    friction.c = f.at("fi3").number();
+    friction.a = f.at("fi1").number_in(kFrictionCoefficient);
+    friction.b = f.at("fi2").number_in(kFrictionCoefficient);
+    friction.c = f.at("fi3").number_in(kFrictionCoefficient);
     friction.offset = friction.a / (1 + std::exp(-friction.b * friction.c));
   } else if (model == "viscous_coulomb") {
     f.allow_only({"model", "coulomb", "viscous", "smoothing_velocity"});
     friction.model = FrictionModel::ViscousCoulomb;
-    friction.a = f.at("coulomb").number_at_least(0);
-    friction.b = f.at("viscous").number_at_least(0);
-    friction.c = f.at("smoothing_velocity").positive();
+    friction.a = f.at("coulomb").number_in(kFrictionTorque, " N m");
+    friction.b = f.at("viscous").number_in(kFrictionTorque, " N m s/rad");
+    friction.c = f.at("smoothing_velocity").number_in(kSmoothingVelocity, " rad/s");
   } else {
     f.at("model").fail("unknown friction model '" + model +
                        "' (expected none, sigmoid or viscous_coulomb)");
@@ -207,9 +226,9 @@ void read_config_joints(RobotModel& model, const JsonField& root) {
       entry.at("name").fail("'" + name + "' is not a moving joint of the chain");
     }
     if (!seen.insert(name).second) entry.at("name").fail("joint '" + name + "' listed twice");
-    it->max_acceleration = entry.at("max_acceleration").positive();
-    it->max_jerk = entry.at("max_jerk").positive();
-    it->max_torque_rate = entry.at("max_torque_rate").positive();
+    it->max_acceleration = entry.at("max_acceleration").number_in(kMaxAcceleration, " rad/s^2");
+    it->max_jerk = entry.at("max_jerk").number_in(kMaxJerk, " rad/s^3");
+    it->max_torque_rate = entry.at("max_torque_rate").number_in(kMaxTorqueRate, " N m/s");
     it->friction = read_friction(entry.at("friction"));
   }
   for (const Joint& j : model.joints) {
@@ -401,7 +420,7 @@ void read_controller(RobotModel& model, const JsonField& root) {
       c.at(key).fail("expected " + std::to_string(model.dof) + " gains, one per moving joint");
     }
     gains->resize(model.dof);
-    for (int i = 0; i < model.dof; ++i) (*gains)[i] = items[i].number_at_least(0);
+    for (int i = 0; i < model.dof; ++i) (*gains)[i] = items[i].number_in(kGain);
   }
   if (c.has("friction_feedforward")) {
     model.controller.friction_feedforward = c.at("friction_feedforward").boolean();
@@ -413,7 +432,7 @@ void read_collision(RobotModel& model, const JsonField& root, const std::string&
                     const std::vector<urdf::LinkConstSharedPtr>& link_sources) {
   const JsonField collision = root.at("collision");
   collision.allow_only({"margin", "allowed_pairs"});
-  model.collision_margin = collision.at("margin").number_at_least(0);
+  model.collision_margin = collision.at("margin").number_in(kCollisionMargin, " m");
   for (size_t i = 0; i < model.links.size(); ++i) {
     add_collision_bodies(model, upath, *link_sources[i], static_cast<int>(i));
   }
@@ -464,11 +483,11 @@ void read_sampling_region(RobotModel& model, const JsonField& root) {
   region.allow_only({"description", "lower", "upper"});
   for (auto [key, bound] : {std::pair<const char*, JointVector*>{"lower", &model.region_lower},
                             std::pair<const char*, JointVector*>{"upper", &model.region_upper}}) {
-    const std::vector<double> v = region.at(key).numbers();
+    const std::vector<JsonField> v = region.at(key).items();
     if (static_cast<int>(v.size()) != n) {
       region.at(key).fail("expected " + std::to_string(n) + " values, one per moving joint");
     }
-    for (int i = 0; i < n; ++i) (*bound)[i] = v[i];
+    for (int i = 0; i < n; ++i) (*bound)[i] = v[i].number_in(kRegionBound, " rad or m");
   }
   for (int i = 0; i < n; ++i) {
     if (!(model.region_lower[i] < model.region_upper[i])) {
@@ -509,10 +528,10 @@ RobotModel load_robot(const std::string& config_path) {
   model.name = root.at("name").string();
   const std::string urdf_rel = root.at("urdf").string();
   model.urdf_path = (fs::path(config_path).parent_path() / urdf_rel).lexically_normal().string();
-  if (root.has("gravity")) model.gravity = root.at("gravity").vec3();
+  if (root.has("gravity")) model.gravity = root.at("gravity").vec3_in(kGravity, " m/s^2");
   if (root.has("control_rate")) {
     const long rate = root.at("control_rate").integer();
-    if (rate <= 0) root.at("control_rate").fail("must be > 0");
+    if (rate < 1 || rate > 1000000) root.at("control_rate").fail("must be in [1, 1000000] Hz");
     model.control_rate = static_cast<double>(rate);
   }
 
