@@ -71,12 +71,20 @@ def tool_batch(tools, bundle, queries, workdir):
     return wall, [json.loads(line) for line in out.splitlines()]
 
 
+def without_timings(d, drop=()):
+    """A result line without its wall times (and the keys in `drop`)."""
+    out = {k: v for k, v in d.items() if k != "time_to_first_solution" and k not in drop}
+    if "post_processing" in out:
+        out["post_processing"] = {k: v for k, v in out["post_processing"].items()
+                                  if k not in ("seconds", "raw_seconds")}
+    return out
+
+
 def same_answers(results, lines):
-    """Every field of the result lines but timing, id and line (the tool's have no trajectory)."""
-    def strip(d):
-        return {k: v for k, v in d.items()
-                if k not in ("time_to_first_solution", "line", "id", "trajectory")}
-    return all(strip(r.to_dict()) == strip(line) for r, line in zip(results, lines))
+    """Every field of the result lines but timings, id and line (the tool's have no trajectory)."""
+    drop = ("line", "id", "trajectory")
+    return all(without_timings(r.to_dict(), drop) == without_timings(line, drop)
+               for r, line in zip(results, lines))
 
 
 def threads_figure(session, queries):
@@ -97,8 +105,8 @@ def threads_figure(session, queries):
         th.join()
     t_par = time.perf_counter() - t
     cpu_share = (time.process_time() - cpu) / t_par  # up to 2 when both threads run at once
-    strip = lambda rs: [{k: v for k, v in r.items() if k != "time_to_first_solution"} for r in rs]
-    same = all(strip(a) == strip(b) for a, b in zip(sequential, concurrent))
+    same = all([without_timings(r) for r in a] == [without_timings(r) for r in b]
+               for a, b in zip(sequential, concurrent))
     return t_seq, t_par, cpu_share, same
 
 
