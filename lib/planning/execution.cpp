@@ -456,8 +456,16 @@ ExecutableTrajectory make_executable(const Simulator& sim, SimulatorWorkspace& w
     Work again{stopping, sim, ws, stop_all, st, {}};
     rows.clear();
     segment_rows.clear();
-    if (!blend_segments(again, plain, raw, start, goal, out.segments, rows, segment_rows))
-      fail("path", "the raw chain fails re-validation");
+    if (!blend_segments(again, plain, raw, start, goal, out.segments, rows, segment_rows)) {
+      // A stop that cannot settle for a dead stop within max_settle_time: the raw chain with
+      // the planners' settle (valid as they simulated it; its junctions are not executable).
+      Work planners{sim, sim, ws, stop_all, st, {}};
+      rows.clear();
+      segment_rows.clear();
+      out.segments.clear();
+      if (!blend_segments(planners, plain, raw, start, goal, out.segments, rows, segment_rows))
+        fail("path", "the raw chain fails re-validation");
+    }
     out.trajectory = assemble(sim, out.segments, rows, segment_rows, std::max(1, sample_every));
     st.steps = st.raw_steps;
     st.junctions = st.raw_steps - 1;
