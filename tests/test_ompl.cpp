@@ -7,7 +7,6 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <cstdlib>
 #include <string>
 #include <thread>
 #include <vector>
@@ -33,14 +32,7 @@ struct Query {
   PlanningProblem problem;
 };
 
-// Wall-clock budgets times LAZYBOE_TEST_TIME_SCALE (default 1): make test-sanitize sets it, as
-// the sanitizers slow the planners several times over and the budgets would run out.
-double time_scale() {
-  const char* s = std::getenv("LAZYBOE_TEST_TIME_SCALE");
-  const double v = s ? std::atof(s) : 1.0;
-  return v > 0 ? v : 1.0;
-}
-
+// Wall-clock budgets are scaled by time_scale() (test_util.h): the sanitizers slow the planners.
 // Start at the centre of a small box, goal 0.39 rad away, tolerance 0.3.
 Query easy_problem(const std::string& planner, double budget, uint64_t seed = 1) {
   PlanningProblem p;
