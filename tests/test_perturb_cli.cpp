@@ -60,8 +60,8 @@ using Clock = std::chrono::steady_clock;
 // watchdog that kills a run that does not end (a hang fails the test instead of stalling it).
 std::string tool_command(const std::string& tool, const std::vector<std::string>& args,
                          double timeout_seconds) {
-  std::string cmd =
-      "timeout -s KILL " + std::to_string(timeout_seconds) + " " + quote(tool_path(tool));
+  std::string cmd = "timeout -s KILL " + std::to_string(timeout_seconds * time_scale()) + " " +
+                    quote(tool_path(tool));
   for (const std::string& a : args) cmd += " " + quote(a);
   return cmd;
 }

@@ -74,4 +74,10 @@ CommandResult run(const std::string& command) {
   return r;
 }
 
+double time_scale() {
+  const char* s = std::getenv("LAZYBOE_TEST_TIME_SCALE");
+  const double v = s ? std::atof(s) : 1.0;
+  return v > 0 ? v : 1.0;
+}
+
 }  // namespace lazyboe::test

@@ -27,6 +27,9 @@ struct Scene {
 
 // A fresh directory under the system temp dir, removed at exit.
 std::string temp_dir();
+// LAZYBOE_TEST_TIME_SCALE (default 1), for wall-clock budgets and watchdogs: make test-sanitize
+// sets it, as the sanitizers slow everything several times over.
+double time_scale();
 std::string write_temp_file(const std::string& name, const std::string& content);
 std::string read_file(const std::string& path);
 

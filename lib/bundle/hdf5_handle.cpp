@@ -24,6 +24,8 @@ herr_t innermost(unsigned n, const H5E_error2_t* err, void* data) {
 std::string hdf5_reason() {
   std::string desc;
   H5Ewalk2(H5E_DEFAULT, H5E_WALK_UPWARD, innermost, &desc);
+  // Read, so cleared: HDF5 does not free the entries' strings left on the stack at exit (LSan).
+  H5Eclear2(H5E_DEFAULT);
   for (char& c : desc)
     if (c == '\n' || c == '\r') c = ' ';
   return desc.empty() ? "" : " (HDF5: " + desc + ")";
