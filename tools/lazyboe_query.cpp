@@ -145,13 +145,9 @@ std::pair<std::string, Outcome> answer(const Job& job, const std::string& text, 
     const PlanResult r = plan(job.context, ws, q.planner, q.parameters, q.problem, &pool);
     Trajectory traj;
     ExecutionStats exec;
-    if (r.success && job.raw) {
-      traj = realize_path(sim, ws, q.problem.start, r.best_path, q.problem.goal, job.sample_every);
-    } else if (r.success) {
-      ExecutableTrajectory e = make_executable(sim, ws, q.problem.start, r.best_path,
-                                               q.problem.goal, job.execution, job.sample_every);
-      traj = std::move(e.trajectory);
-      exec = e.stats;
+    if (r.success) {
+      traj = returned_trajectory(sim, ws, q.problem, r.best_path, job.raw, job.execution,
+                                 job.sample_every, exec);
     }
     std::string csv;
     if (r.success && job.mode == TrajectoryOutput::Csv) {

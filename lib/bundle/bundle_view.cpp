@@ -131,8 +131,6 @@ BundleView BundleView::from_memory(std::shared_ptr<const Bundle> bundle, std::st
   v.knot_offset_ = b.knot_offset.data();
   v.knots_ = b.knots.data();
   v.check_knot_ranges(b.knots.size() / static_cast<size_t>(b.dof()));
-  v.check_values(b.knots.size() / static_cast<size_t>(b.dof()),
-                 b.sample_q.size() / static_cast<size_t>(b.dof()), b.sample_offset.data());
   const Perturbation& p = b.perturbation;
   if (p.present && v.use_perturbation(p.complete)) {
     v.perturbation_theta_ = p.theta;
@@ -144,6 +142,9 @@ BundleView BundleView::from_memory(std::shared_ptr<const Bundle> bundle, std::st
       v.has_transfer_ = true;
     }
   }
+  // After the perturbation is attached, so that its values are checked too (as open does).
+  v.check_values(b.knots.size() / static_cast<size_t>(b.dof()),
+                 b.sample_q.size() / static_cast<size_t>(b.dof()), b.sample_offset.data());
   return v;
 }
 

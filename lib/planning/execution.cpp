@@ -131,6 +131,17 @@ RolloutResult simulate_to_target(Work& w, const JointVectorRef& q0, std::vector<
 
 }  // namespace
 
+Trajectory returned_trajectory(const Simulator& sim, SimulatorWorkspace& ws,
+                               const PlanningProblem& problem, const std::vector<PathStep>& path,
+                               bool raw, const ExecutionOptions& options, int sample_every,
+                               ExecutionStats& stats) {
+  if (raw) return realize_path(sim, ws, problem.start, path, problem.goal, sample_every);
+  ExecutableTrajectory e =
+      make_executable(sim, ws, problem.start, path, problem.goal, options, sample_every);
+  stats = e.stats;
+  return std::move(e.trajectory);
+}
+
 Simulator execution_simulator(const Simulator& sim) {
   Simulator stopping = sim;
   stopping.options.settle_for_stop = true;

@@ -90,6 +90,14 @@ ExecutableTrajectory make_executable(const Simulator& sim, SimulatorWorkspace& w
 // and the raw chain keep `sim`'s settle, as the planners simulated them.
 Simulator execution_simulator(const Simulator& sim);
 
+// What a front end returns for a solved problem (lazyboe-query, the Python module): the
+// executable trajectory, its figures in `stats`, or with `raw` the planner's edge chain as
+// realize_path gives it (`stats` untouched).
+Trajectory returned_trajectory(const Simulator& sim, SimulatorWorkspace& ws,
+                               const PlanningProblem& problem, const std::vector<PathStep>& path,
+                               bool raw, const ExecutionOptions& options, int sample_every,
+                               ExecutionStats& stats);
+
 // A joint-space straight line from rest by `displacement` to rest, as fast as `limits` allow the
 // commanded velocity, acceleration and jerk (N intervals: knots 0, v, ..., v, 0); false when
 // the displacement is (numerically) zero.

@@ -85,15 +85,9 @@ PyResult answer(const Session& s, SimulatorWorkspace& ws, RolloutPool& pool, con
                 int sample_every, bool raw) {
   PyResult r{q, {}, {}, raw, {}};
   r.result = plan(*s.context, ws, q.planner, q.parameters, q.problem, &pool);
-  if (r.result.success && raw) {
-    r.trajectory = realize_path(s.session->sim, ws, q.problem.start, r.result.best_path,
-                                q.problem.goal, sample_every);
-  } else if (r.result.success) {
-    ExecutableTrajectory e =
-        make_executable(s.session->sim, ws, q.problem.start, r.result.best_path, q.problem.goal,
-                        s.execution, sample_every);
-    r.trajectory = std::move(e.trajectory);
-    r.execution = e.stats;
+  if (r.result.success) {
+    r.trajectory = returned_trajectory(s.session->sim, ws, q.problem, r.result.best_path, raw,
+                                       s.execution, sample_every, r.execution);
   }
   return r;
 }
