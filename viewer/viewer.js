@@ -58,8 +58,22 @@
   }
 
   // ---- Scene ----------------------------------------------------------------------------
+  // A software rasteriser (SwiftShader in headless Chromium, llvmpipe) draws without
+  // antialiasing: multisampling on the CPU costs most of the frame.
+  function webglRenderer() {
+    const gl = document.createElement('canvas').getContext('webgl');
+    if (!gl) return null;
+    const info = gl.getExtension('WEBGL_debug_renderer_info');
+    return String(gl.getParameter(info ? info.UNMASKED_RENDERER_WEBGL : gl.RENDERER));
+  }
+  const rendererName = webglRenderer();
+  if (rendererName === null) {
+    body.setAttribute('data-status', 'no-webgl');
+    throw new Error('this browser has no WebGL: the 3-D scene cannot be drawn');
+  }
+  const software = /swiftshader|llvmpipe|software/i.test(rendererName);
   const view = $('view');
-  const renderer = new THREE.WebGLRenderer({antialias: true, preserveDrawingBuffer: true});
+  const renderer = new THREE.WebGLRenderer({antialias: !software, preserveDrawingBuffer: true});
   renderer.setPixelRatio(window.devicePixelRatio || 1);
   view.appendChild(renderer.domElement);
   const scene = new THREE.Scene();
@@ -116,12 +130,18 @@
   }
 
   const robot = data.robot;
+  const robotLayer = new THREE.Group();  // the robot and its ghosts
+  scene.add(robotLayer);
   function makeRobot(colour, opacity) {
-    const material = new THREE.MeshLambertMaterial({color: colour, transparent: opacity < 1, opacity: opacity,
-                                                    depthWrite: opacity >= 1});
+    // A ghost's surfaces are pushed back in depth, so where it coincides with the robot (at the
+    // start, at the goal) the robot is drawn, not a flicker of both.
+    const ghost = opacity < 1;
+    const material = new THREE.MeshLambertMaterial({color: colour, transparent: ghost, opacity: opacity,
+                                                    depthWrite: !ghost, polygonOffset: ghost,
+                                                    polygonOffsetFactor: 2, polygonOffsetUnits: 2});
     const group = new THREE.Group();
     const parts = robot.shapes.map((s) => { const o = shapeObject(s, material); group.add(o); return o; });
-    scene.add(group);
+    robotLayer.add(group);
     return {
       group: group,
       setQ(q) {
@@ -151,6 +171,7 @@
   const results = data.results;
   const trajectories = results ? results.trajectories : [];
   const failures = results ? results.failures : [];
+  const plural = (n, one, many) => n + ' ' + (n === 1 ? one : many || one + 's');
   const tipPosition = (q) => linkPoses(robot, q)[robot.tip].p;
   trajectories.forEach((tr, i) => {
     tr.colour = new THREE.Color().setHSL((i * 0.618034) % 1, 0.75, 0.45);
@@ -163,11 +184,11 @@
   });
   if (!results) say('No results file given (lazyboe-view --results): robot and obstacles only.');
   else if (trajectories.length === 0)
-    say('No trajectories: ' + results.results + ' results in ' + results.path + ', none with a trajectory to play.');
+    say('No trajectories: ' + plural(results.results, 'result') + ' in ' + results.path + ', none with a trajectory to play.');
   if (results && results.without_trajectory.length > 0)
     say(results.without_trajectory.length + ' successful results carry no trajectory ' +
         '(run lazyboe-query with --trajectories inline or csv).');
-  if (failures.length > 0) say(failures.length + ' of ' + results.results + ' queries failed (listed below).');
+  if (failures.length > 0) say(failures.length + ' of ' + plural(results.results, 'query', 'queries') + ' failed (listed below).');
 
   const fmt = (v, unit) => (v === undefined || v === null ? '-' : Number(v).toFixed(2) + unit);
   function row(cells, onClick) {
@@ -251,7 +272,7 @@
       f.row.classList.add('selected');
       showEnds(f.start, f.goal);
       mainRobot.group.visible = !f.start;  // the start ghost stands for the robot
-      $('time').textContent = 'failed: ' + f.reason;
+      $('time').textContent = 'failed: ' + f.reason + (f.start ? ' (start: green, goal: red)' : ' (start and goal unknown: lazyboe-view --queries)');
     }
     $('play').textContent = play.playing ? 'Pause' : 'Play';
   }
@@ -354,7 +375,8 @@
   // The robot's box on the page, in CSS pixels, for the screenshot check.
   function robotScreenBox() {
     scene.updateMatrixWorld(true);
-    const box = new THREE.Box3().setFromObject(mainRobot.group);
+    const shown = mainRobot.group.visible ? mainRobot : startGhost;
+    const box = new THREE.Box3().setFromObject(shown.group);
     const rect = renderer.domElement.getBoundingClientRect();
     const xs = [], ys = [];
     for (const x of [box.min.x, box.max.x])
@@ -374,10 +396,15 @@
     frameStats: frameStats,
     resetFrameStats() { frames.intervals = []; frames.renderMs = []; },
     robotScreenBox: robotScreenBox,
+    // Robot and ghosts shown or hidden (the screenshot check compares both).
+    showRobots(on) {
+      robotLayer.visible = on;
+    },
     play() { if (!play.playing) $('play').click(); },
     setSpeed(s) { play.speed = s; },
     select: select,
     messages: messages,
+    renderer: rendererName,
   };
   renderer.render(scene, camera);
   body.setAttribute('data-robot-shapes', String(robot.shapes.length));
