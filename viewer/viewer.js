@@ -73,7 +73,7 @@
   }
   const software = /swiftshader|llvmpipe|software/i.test(rendererName);
   const view = $('view');
-  const renderer = new THREE.WebGLRenderer({antialias: !software, preserveDrawingBuffer: true});
+  const renderer = new THREE.WebGLRenderer({antialias: !software});
   renderer.setPixelRatio(window.devicePixelRatio || 1);
   view.appendChild(renderer.domElement);
   const scene = new THREE.Scene();
@@ -111,7 +111,7 @@
   function shapeObject(s, material) {
     const along = (g) => g.rotateX(Math.PI / 2);
     switch (s.type) {
-      case 'sphere': return new THREE.Mesh(new THREE.SphereBufferGeometry(s.radius, 24, 16), material);
+      case 'sphere': return new THREE.Mesh(new THREE.SphereBufferGeometry(s.radius, 20, 12), material);
       case 'box': return new THREE.Mesh(new THREE.BoxBufferGeometry(s.size[0], s.size[1], s.size[2]), material);
       case 'cylinder':
         return new THREE.Mesh(along(new THREE.CylinderBufferGeometry(s.radius, s.radius, s.length, 24)), material);
@@ -119,7 +119,7 @@
         const g = new THREE.Group();
         g.add(new THREE.Mesh(along(new THREE.CylinderBufferGeometry(s.radius, s.radius, s.length, 24, 1, true)), material));
         for (const z of [-s.length / 2, s.length / 2]) {
-          const end = new THREE.Mesh(new THREE.SphereBufferGeometry(s.radius, 24, 12), material);
+          const end = new THREE.Mesh(new THREE.SphereBufferGeometry(s.radius, 20, 10), material);
           end.position.z = z;
           g.add(end);
         }
@@ -157,7 +157,7 @@
                                     new THREE.MeshLambertMaterial({color: 0xc03030, transparent: true, opacity: 0.3}));
   scene.add(goalRegion);
 
-  const obstacleMaterial = new THREE.MeshLambertMaterial({color: 0x7088a8, transparent: true, opacity: 0.8});
+  const obstacleMaterial = new THREE.MeshLambertMaterial({color: 0x7088a8});
   for (const o of data.environment.obstacles) {
     const object = shapeObject(o, obstacleMaterial);
     setMatrix(object, o.pose);
@@ -372,6 +372,19 @@
     requestAnimationFrame(animate);
   }
 
+  // What one frame of playback costs: `n` frames drawn back to back, each finished (gl.finish
+  // waits for the rasteriser), in ms per frame. Apart from how the browser schedules frames.
+  function frameCost(n) {
+    const gl = renderer.getContext();
+    const t0 = performance.now();
+    for (let i = 0; i < n; ++i) {
+      if (play.selected) setTime((play.time + 1 / 60) % Math.max(1e-9, duration()));
+      renderer.render(scene, camera);
+      gl.finish();
+    }
+    return (performance.now() - t0) / n;
+  }
+
   // The robot's box on the page, in CSS pixels, for the screenshot check.
   function robotScreenBox() {
     scene.updateMatrixWorld(true);
@@ -394,6 +407,7 @@
     linkPoses: (q) => linkPoses(robot, q).map((p, i) => ({link: robot.links[i].name, position: p.p,
                                                           quaternion: quaternion(p.R)})),
     frameStats: frameStats,
+    frameCost: frameCost,
     resetFrameStats() { frames.intervals = []; frames.renderMs = []; },
     robotScreenBox: robotScreenBox,
     // Robot and ghosts shown or hidden (the screenshot check compares both).
