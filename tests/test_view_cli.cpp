@@ -285,6 +285,18 @@ TEST(ViewCli, ResultsThatDoNotMatchTheQueries) {
   expect_no_page(dir);
 }
 
+TEST(ViewCli, QueryGoalOfTheWrongSizeNamesTheField) {
+  const std::string dir = fresh_dir("view_goal");
+  write_temp_file("view_goal/results.jsonl", lines({failed_result("a", 1, "time budget")}));
+  json query = query_line("a", kReady, kOther);
+  query["goal"]["q"].erase(0);
+  write_temp_file("view_goal/queries.jsonl", lines({query}));
+  expect_one_line_error(view_tool({"--results", dir + "/results.jsonl", "--queries",
+                                   dir + "/queries.jsonl", "--out", dir + "/view.html"}),
+                        {"queries.jsonl:1", "goal.q", "7 numbers"});
+  expect_no_page(dir);
+}
+
 TEST(ViewCli, MissingThreeJsIsOneClearLine) {
   const std::string dir = fresh_dir("view_three");
   expect_one_line_error(view_tool({"--three-dir", dir + "/nothing", "--out", dir + "/view.html"}),

@@ -263,7 +263,14 @@
       const q = tr.samples.q;
       showEnds(tr.start || q[0], tr.goal || {q: q[q.length - 1]});
       mainRobot.group.visible = true;
-      trajectories.forEach((o) => { o.line.material.linewidth = o === tr ? 2 : 1; });
+      trajectories.forEach((o) => {  // the selected path stands out (line widths are 1 in WebGL)
+        o.line.material.transparent = o !== tr;
+        o.line.material.opacity = o === tr ? 1 : 0.35;
+      });
+      $('selected-info').textContent = tr.id + ' (' + tr.planner + ', line ' + tr.line + '): success, cost ' +
+        fmt(tr.cost, '') + ', duration ' + fmt(tr.duration, ' s') + ', first solution after ' +
+        fmt(tr.time_to_first_solution, ' s') + '; edges ' + (tr.edges.join(' ') || 'none') +
+        ' (-1: a command that is not a bundle edge)';
       setTime(0);
     } else {
       const f = failures[i];
@@ -272,6 +279,8 @@
       f.row.classList.add('selected');
       showEnds(f.start, f.goal);
       mainRobot.group.visible = !f.start;  // the start ghost stands for the robot
+      $('selected-info').textContent = (f.id === null ? '(no id)' : f.id) + ' (' + (f.planner || '-') + ', line ' +
+        f.line + '): ' + f.kind + ': ' + f.reason;
       $('time').textContent = 'failed: ' + f.reason + (f.start ? ' (start: green, goal: red)' : ' (start and goal unknown: lazyboe-view --queries)');
     }
     $('play').textContent = play.playing ? 'Pause' : 'Play';

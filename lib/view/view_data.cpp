@@ -77,11 +77,20 @@ namespace {
 
 struct QueryEnds {
   std::string id;
-  json start, goal;  // null when the query line did not have them readable
+  json start, goal;  // goal: {q} or {position}, with its tolerance when given
 };
 
-// Start and goal of each query line (1-based), read loosely: the viewer only draws them, and
-// lazyboe-query has checked them already. A line that is not JSON is an error.
+// A joint vector of the robot's size, as the page's kinematics needs it.
+json joint_vector(const JsonField& field, int dof) {
+  const std::vector<double> v = field.numbers();
+  if (v.size() != size_t(dof))
+    field.fail("expected " + std::to_string(dof) + " numbers (the robot's joints)");
+  return v;
+}
+
+// Start and goal of each query line (1-based). Only what the page draws is read (lazyboe-query
+// has checked the rest), but that strictly: a line that is not JSON, a start or goal.q of the
+// wrong size, a goal.position that is not 3 numbers are errors naming the line and field.
 std::map<int, QueryEnds> read_query_ends(const std::string& path, int dof) {
   require_input_file(path, "queries");
   std::ifstream in(path);
@@ -89,14 +98,22 @@ std::map<int, QueryEnds> read_query_ends(const std::string& path, int dof) {
   std::string text;
   for (int line = 1; std::getline(in, text); ++line) {
     if (text.find_first_not_of(" \t\r") == std::string::npos) continue;
-    const json q = parse_json_text(text, path + ":" + std::to_string(line), false);
+    const std::string where = path + ":" + std::to_string(line);
+    const json value = parse_json_text(text, where, false);
+    const JsonField q(value, where, "");
+    if (!value.is_object()) q.fail("expected a query object (schemas/query.schema.json)");
     QueryEnds e;
-    if (q.is_object()) {
-      if (q.contains("id") && q["id"].is_string()) e.id = q["id"];
-      if (q.contains("start") && q["start"].is_array() && q["start"].size() == size_t(dof))
-        e.start = q["start"];
-      if (q.contains("goal") && q["goal"].is_object()) e.goal = q["goal"];
+    if (value.contains("id") && value["id"].is_string()) e.id = value["id"];
+    e.start = joint_vector(q.at("start"), dof);
+    const JsonField goal = q.at("goal");
+    if (!value["goal"].is_object()) goal.fail("expected an object");
+    e.goal = json::object();
+    if (goal.has("q")) e.goal["q"] = joint_vector(goal.at("q"), dof);
+    if (goal.has("position")) {
+      const Eigen::Vector3d p = goal.at("position").vec3();
+      e.goal["position"] = {p.x(), p.y(), p.z()};
     }
+    if (goal.has("tolerance")) e.goal["tolerance"] = goal.at("tolerance").positive();
     out[line] = e;
   }
   return out;

@@ -51,8 +51,9 @@ class Chromium:
                 "--disable-background-networking", "--disable-component-update",
                 "--enable-unsafe-swiftshader", "--use-angle=swiftshader",
                 "--user-data-dir=" + self.profile, f"--window-size={width},{height}", "about:blank"]
-        if os.geteuid() == 0:
-            args.insert(1, "--no-sandbox")  # Chromium refuses to run as root with its sandbox
+        # Chromium refuses to run as root with its sandbox, and in many containers it cannot set
+        # one up at all; the pages opened are our own local files. /dev/shm is often tiny there.
+        args[1:1] = ["--no-sandbox", "--disable-dev-shm-usage"]
         self.proc = subprocess.Popen(args, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
                                      stderr=subprocess.DEVNULL, preexec_fn=child_fds,
                                      pass_fds=(3, 4))
