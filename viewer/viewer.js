@@ -179,8 +179,8 @@
     tr.samples.q.forEach((q, k) => path.set(tipPosition(q), 3 * k));
     const g = new THREE.BufferGeometry();
     g.addAttribute('position', new THREE.BufferAttribute(path, 3));
-    tr.line = new THREE.Line(g, new THREE.LineBasicMaterial({color: tr.colour}));
-    scene.add(tr.line);
+    tr.path = new THREE.Line(g, new THREE.LineBasicMaterial({color: tr.colour}));
+    scene.add(tr.path);
   });
   if (!results) say('No results file given (lazyboe-view --results): robot and obstacles only.');
   else if (trajectories.length === 0)
@@ -264,8 +264,8 @@
       showEnds(tr.start || q[0], tr.goal || {q: q[q.length - 1]});
       mainRobot.group.visible = true;
       trajectories.forEach((o) => {  // the selected path stands out (line widths are 1 in WebGL)
-        o.line.material.transparent = o !== tr;
-        o.line.material.opacity = o === tr ? 1 : 0.35;
+        o.path.material.transparent = o !== tr;
+        o.path.material.opacity = o === tr ? 1 : 0.35;
       });
       $('selected-info').textContent = tr.id + ' (' + tr.planner + ', line ' + tr.line + '): success, cost ' +
         fmt(tr.cost, '') + ', duration ' + fmt(tr.duration, ' s') + ', first solution after ' +

@@ -158,6 +158,8 @@ def main():
         check(state.get("bundlePoints") == "400", "main page: 400 bundle points (200 edges)")
         text = browser.evaluate("document.body.innerText")
         check("no bundle coverage of the goal" in text, "main page: the failure reason is shown")
+        check("a (lazysp, line 1): success, cost 1.00, duration 1.00 s" in text and "edges 3 5" in text,
+              "main page: the selected trajectory's id, planner, line, cost, duration and edges are shown")
         nonblank_robot(browser, os.path.join(out_dir, "viewer.png"), "main page")
         rng = random.Random(17)
         configurations = [READY, OTHER, THIRD] + [[rng.uniform(-2.5, 2.5) for _ in range(7)] for _ in range(2)]
