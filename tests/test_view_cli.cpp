@@ -239,6 +239,22 @@ TEST(ViewCli, BundleSampleIsSeededAndMatchesTheKinematics) {
   for (int k = 0; k < 3; ++k) EXPECT_NEAR(d["points"][k].get<double>(), p[k], 0.5e-4);
 }
 
+// A bundle without a perturbation analysis: density only, and the page is told so.
+TEST(ViewCli, BundleWithoutPerturbationHasDensityOnly) {
+  const std::string dir = fresh_dir("view_unperturbed");
+  const std::string bundle = dir + "/b.h5";
+  const CommandResult b = run(quote(tool_path("lazyboe-build")) + " --out " + quote(bundle) +
+                              " --edges 30 --seed 4 --quiet");
+  ASSERT_EQ(b.exit_code, 0) << describe(b);
+  const std::string out = dir + "/view.html";
+  const CommandResult r = view_tool({"--bundle", bundle, "--out", out});
+  ASSERT_EQ(r.exit_code, 0) << describe(r);
+  const json d = page_data(out)["bundle"];
+  EXPECT_FALSE(d["has_perturbation"].get<bool>());
+  EXPECT_FALSE(d.contains("p_lazy_prop"));
+  EXPECT_EQ(d["density"].size(), 60u);  // every edge: fewer than the points asked for
+}
+
 // ---- Bad input: one line naming what is wrong, no page -----------------------------------
 
 void expect_no_page(const std::string& dir) {
