@@ -115,15 +115,11 @@
       case 'box': return new THREE.Mesh(new THREE.BoxBufferGeometry(s.size[0], s.size[1], s.size[2]), material);
       case 'cylinder':
         return new THREE.Mesh(along(new THREE.CylinderBufferGeometry(s.radius, s.radius, s.length, 24)), material);
-      case 'capsule': {
-        const g = new THREE.Group();
-        g.add(new THREE.Mesh(along(new THREE.CylinderBufferGeometry(s.radius, s.radius, s.length, 24, 1, true)), material));
-        for (const z of [-s.length / 2, s.length / 2]) {
-          const end = new THREE.Mesh(new THREE.SphereBufferGeometry(s.radius, 20, 10), material);
-          end.position.z = z;
-          g.add(end);
-        }
-        return g;
+      case 'capsule': {  // one geometry (a cylinder and two spheres): one draw call
+        const g = along(new THREE.CylinderGeometry(s.radius, s.radius, s.length, 20, 1, true));
+        for (const z of [-s.length / 2, s.length / 2])
+          g.merge(new THREE.SphereGeometry(s.radius, 20, 10).translate(0, 0, z));
+        return new THREE.Mesh(new THREE.BufferGeometry().fromGeometry(g), material);
       }
       default: throw new Error('unknown shape type ' + s.type + ' (' + s.name + ')');
     }
@@ -173,15 +169,26 @@
   const failures = results ? results.failures : [];
   const plural = (n, one, many) => n + ' ' + (n === 1 ? one : many || one + 's');
   const tipPosition = (q) => linkPoses(robot, q)[robot.tip].p;
+  // Every end-effector path in one draw call (segments coloured per trajectory, faint), and
+  // the selected one drawn again on top, opaque.
+  const segments = [], segmentColours = [];
   trajectories.forEach((tr, i) => {
     tr.colour = new THREE.Color().setHSL((i * 0.618034) % 1, 0.75, 0.45);
-    const path = new Float32Array(tr.samples.q.length * 3);
-    tr.samples.q.forEach((q, k) => path.set(tipPosition(q), 3 * k));
-    const g = new THREE.BufferGeometry();
-    g.addAttribute('position', new THREE.BufferAttribute(path, 3));
-    tr.path = new THREE.Line(g, new THREE.LineBasicMaterial({color: tr.colour}));
-    scene.add(tr.path);
+    tr.pathPoints = new Float32Array(tr.samples.q.length * 3);
+    tr.samples.q.forEach((q, k) => tr.pathPoints.set(tipPosition(q), 3 * k));
+    for (let k = 3; k < tr.pathPoints.length; k += 3) {
+      segments.push(...tr.pathPoints.subarray(k - 3, k + 3));
+      segmentColours.push(tr.colour.r, tr.colour.g, tr.colour.b, tr.colour.r, tr.colour.g, tr.colour.b);
+    }
   });
+  const allPaths = new THREE.BufferGeometry();
+  allPaths.addAttribute('position', new THREE.BufferAttribute(new Float32Array(segments), 3));
+  allPaths.addAttribute('color', new THREE.BufferAttribute(new Float32Array(segmentColours), 3));
+  scene.add(new THREE.LineSegments(allPaths, new THREE.LineBasicMaterial({
+    vertexColors: THREE.VertexColors, transparent: true, opacity: 0.4, depthWrite: false})));
+  const selectedPath = new THREE.Line(new THREE.BufferGeometry(), new THREE.LineBasicMaterial());
+  selectedPath.visible = false;
+  scene.add(selectedPath);
   if (!results) say('No results file given (lazyboe-view --results): robot and obstacles only.');
   else if (trajectories.length === 0)
     say('No trajectories: ' + plural(results.results, 'result') + ' in ' + results.path + ', none with a trajectory to play.');
@@ -247,10 +254,16 @@
     return samples.q[lo].map((v, k) => v + a * (samples.q[hi][k] - v));
   }
   function duration() { const s = selectedSamples(); return s ? s.t[s.t.length - 1] : 0; }
-  function setTime(t) {
+  // The time label and slider follow playback at 10 Hz: changing them every frame makes the
+  // browser lay out and repaint the panel every frame, which costs more than the 3-D scene.
+  let lastLabel = -Infinity;
+  function setTime(t, playing) {
     play.time = Math.max(0, Math.min(duration(), t));
     const s = selectedSamples();
     if (s) mainRobot.setQ(qAt(s, play.time));
+    const now = performance.now();
+    if (playing && now - lastLabel < 100) return;
+    lastLabel = now;
     $('time').textContent = play.time.toFixed(2) + ' / ' + duration().toFixed(2) + ' s';
     $('timeline').value = duration() > 0 ? String(Math.round(1000 * play.time / duration())) : '0';
   }
@@ -263,10 +276,11 @@
       const q = tr.samples.q;
       showEnds(tr.start || q[0], tr.goal || {q: q[q.length - 1]});
       mainRobot.group.visible = true;
-      trajectories.forEach((o) => {  // the selected path stands out (line widths are 1 in WebGL)
-        o.path.material.transparent = o !== tr;
-        o.path.material.opacity = o === tr ? 1 : 0.35;
-      });
+      selectedPath.geometry.dispose();
+      selectedPath.geometry = new THREE.BufferGeometry();
+      selectedPath.geometry.addAttribute('position', new THREE.BufferAttribute(tr.pathPoints, 3));
+      selectedPath.material.color = tr.colour;
+      selectedPath.visible = true;
       $('selected-info').textContent = tr.id + ' (' + tr.planner + ', line ' + tr.line + '): success, cost ' +
         fmt(tr.cost, '') + ', duration ' + fmt(tr.duration, ' s') + ', first solution after ' +
         fmt(tr.time_to_first_solution, ' s') + '; edges ' + (tr.edges.join(' ') || 'none') +
@@ -276,6 +290,7 @@
       const f = failures[i];
       play.selected = null;
       play.playing = false;
+      selectedPath.visible = false;
       f.row.classList.add('selected');
       showEnds(f.start, f.goal);
       mainRobot.group.visible = !f.start;  // the start ghost stands for the robot
@@ -368,8 +383,8 @@
       frames.intervals.push(dt);
       if (frames.intervals.length > 600) frames.intervals.shift();
       if (play.playing) {
-        setTime(play.time + play.speed * dt / 1000);
-        if (play.time >= duration()) setTime(0);  // loop
+        setTime(play.time + play.speed * dt / 1000, true);
+        if (play.time >= duration()) setTime(0, true);  // loop
       }
     }
     frames.last = now;
@@ -387,7 +402,7 @@
     const gl = renderer.getContext();
     const t0 = performance.now();
     for (let i = 0; i < n; ++i) {
-      if (play.selected) setTime((play.time + 1 / 60) % Math.max(1e-9, duration()));
+      if (play.selected) setTime((play.time + 1 / 60) % Math.max(1e-9, duration()), true);
       renderer.render(scene, camera);
       gl.finish();
     }
