@@ -82,7 +82,6 @@ def measure(binary, page, width, height, seconds):
         # CPU time the whole browser (every process) spends per frame drawn: less dependent on
         # the machine's load than the frame rate; 2 cores give 33 ms of CPU per 60 fps frame.
         stats["cpu_ms_per_frame"] = 1000 * (cpu1 - cpu0) / max(1, stats["frames"] - frames0)
-        stats["frame_cost_ms"] = browser.evaluate("lazyboeView.frameCost(120)")
         stats["load_ms"] = float(state["loadMs"])
         stats["state"] = state
         stats["renderer"] = browser.evaluate("lazyboeView.renderer")
@@ -112,15 +111,14 @@ def main():
         runs.append(s)
         print(f"load {s['load_ms']:.0f} ms, {s['fps']:.1f} fps (mean frame interval "
               f"{s['mean_interval_ms']:.1f} ms, p95 {s['p95_interval_ms']:.1f} ms, render call "
-              f"{s['mean_render_ms']:.2f} ms); Chromium CPU time {s['cpu_ms_per_frame']:.1f} ms per frame; frame cost {s['frame_cost_ms']:.1f} ms "
-              f"(120 frames drawn and finished back to back); machine load average {load:.2f}")
+              f"{s['mean_render_ms']:.2f} ms); Chromium CPU time {s['cpu_ms_per_frame']:.1f} ms per frame, machine load average "
+              f"{load:.2f}")
     st = runs[0]["state"]
     print(f"page {os.path.getsize(page) / 1e6:.2f} MB: {st['trajectories']} trajectories, "
           f"{st['bundlePoints']} bundle points, {st['robotShapes']} robot shapes, renderer "
           f"{runs[0]['renderer']}, {width}x{height}; console errors: {runs[0]['errors']}")
     print(f"median: load {statistics.median(r['load_ms'] for r in runs):.0f} ms, "
-          f"{statistics.median(r['fps'] for r in runs):.1f} fps, frame cost "
-          f"{statistics.median(r['frame_cost_ms'] for r in runs):.1f} ms, Chromium CPU time "
+          f"{statistics.median(r['fps'] for r in runs):.1f} fps, Chromium CPU time "
           f"{statistics.median(r['cpu_ms_per_frame'] for r in runs):.1f} ms per frame")
 
 

@@ -396,19 +396,6 @@
     requestAnimationFrame(animate);
   }
 
-  // What one frame of playback costs: `n` frames drawn back to back, each finished (gl.finish
-  // waits for the rasteriser), in ms per frame. Apart from how the browser schedules frames.
-  function frameCost(n) {
-    const gl = renderer.getContext();
-    const t0 = performance.now();
-    for (let i = 0; i < n; ++i) {
-      if (play.selected) setTime((play.time + 1 / 60) % Math.max(1e-9, duration()), true);
-      renderer.render(scene, camera);
-      gl.finish();
-    }
-    return (performance.now() - t0) / n;
-  }
-
   // The robot's box on the page, in CSS pixels, for the screenshot check.
   function robotScreenBox() {
     scene.updateMatrixWorld(true);
@@ -431,7 +418,6 @@
     linkPoses: (q) => linkPoses(robot, q).map((p, i) => ({link: robot.links[i].name, position: p.p,
                                                           quaternion: quaternion(p.R)})),
     frameStats: frameStats,
-    frameCost: frameCost,
     resetFrameStats() { frames.intervals = []; frames.renderMs = []; },
     robotScreenBox: robotScreenBox,
     // Robot and ghosts shown or hidden (the screenshot check compares both).
