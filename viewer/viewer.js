@@ -254,8 +254,8 @@
     return samples.q[lo].map((v, k) => v + a * (samples.q[hi][k] - v));
   }
   function duration() { const s = selectedSamples(); return s ? s.t[s.t.length - 1] : 0; }
-  // The time label and slider follow playback at 10 Hz: changing them every frame makes the
-  // browser lay out and repaint the panel every frame, which costs more than the 3-D scene.
+  // The time label and slider follow playback at 10 Hz: changed every frame, they would have
+  // the browser lay out and repaint the panel every frame too.
   let lastLabel = -Infinity;
   function setTime(t, playing) {
     play.time = Math.max(0, Math.min(duration(), t));
