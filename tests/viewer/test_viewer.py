@@ -13,6 +13,7 @@ import os
 import random
 import subprocess
 import sys
+import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import chromium  # noqa: E402
@@ -167,6 +168,19 @@ def main():
         browser.evaluate("lazyboeView.play()")
         check(browser.wait_for("lazyboeView.frameStats().frames > 10", 20), "main page: plays (frames drawn)")
         check(not browser.console_errors, f"main page: no console errors while playing {browser.console_errors}")
+        # The harness sees errors when there are some (so "no console errors" above means it).
+        browser.evaluate("console.error('probe'); setTimeout(() => { throw new Error('thrown probe'); }, 0)")
+        for _ in range(50):  # each call also collects the events that came meanwhile
+            if len(browser.console_errors) >= 2:
+                break
+            browser.evaluate("1")
+            time.sleep(0.02)
+        check(browser.wait_for("document.body.dataset.errors === '1' && !document.getElementById('errors').hidden", 5),
+              "an uncaught exception is shown on the page and counted in data-errors")
+        check(any("probe" in e for e in browser.console_errors) and
+              any("thrown probe" in e for e in browser.console_errors),
+              f"console errors and uncaught exceptions are caught by the test ({browser.console_errors})")
+        browser.console_errors.clear()
 
         state = open_page(browser, only_failed, "failed-only page")
         text = browser.evaluate("document.body.innerText")
