@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The main job on the bundled defaults: the robot model at work, then the whole pipeline on the
 # default environment (table.json): a small edge bundle, its perturbation analysis, and the
-# bundled sample batch answered by every planner.
+# bundled sample batch answered by every planner, and a viewer page of it all.
 set -euo pipefail
 build=${1:-build}
 bin="$build/bin"
@@ -45,5 +45,10 @@ if ok:
           f"{m('stops'):.0f} stops, against {m('raw_duration'):.2f} s and {m('raw_stops'):.0f} "
           "stops for the raw edge chains (lazyboe-query --raw)")
 PY
+echo
+echo "== 5. Viewer: robot, table, the trajectories above and a sample of the bundle, in 3-D"
+"$bin/lazyboe-view" --results "$out/results.jsonl" --queries data/queries/table-demo.jsonl \
+  --bundle "$out/bundle.h5" --bundle-points 4000 --title "LazyBoE demo: table.json" --out "$out/view.html"
+echo "   open in a browser (one self-contained file): $(realpath "$out/view.html")"
 echo
 echo "demo: done (outputs in $out/)"

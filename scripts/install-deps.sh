@@ -14,6 +14,9 @@ packages=(
   # Optional for the build (lazyboe-bench skips what is missing, and says so), installed so
   # that the demo and the tests cover OMPL's planners and the benchmark figures.
   libompl-dev python3-matplotlib
+  # lazyboe-view (issue 17): three.js (with OrbitControls) inlined into its pages, and the
+  # browser its tests open them in (headless; they are skipped without it).
+  libjs-three chromium
 )
 # Extra packages a caller asks for.
 packages+=("$@")

@@ -1,0 +1,203 @@
+#!/usr/bin/env python3
+"""lazyboe-view's pages in headless Chromium (issue 17): no console errors, the scene reports
+the robot, the obstacles and the trajectories it loaded, a screenshot that is not blank where
+the robot is, link poses equal to `lazyboe-robot fk` to 1e-6, and bad input (only failed
+queries, results without trajectories) giving a page that says so.
+
+Usage: test_viewer.py BIN_DIR OUT_DIR. Exits 77 (ctest: skipped) when Chromium is not installed.
+The screenshot of the main page is OUT_DIR/viewer.png (the README's, docs/images/viewer.png)."""
+
+import json
+import math
+import os
+import random
+import subprocess
+import sys
+import time
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import chromium  # noqa: E402
+
+SOURCE = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+READY = [0, -0.785, 0, -2.356, 0, 1.571, 0.785]
+OTHER = [0.3, -0.5, 0.2, -2.0, 0.1, 1.8, 0.4]
+THIRD = [-0.6, 0.3, -0.4, -1.4, 0.5, 2.2, -0.3]
+BACKGROUND = (242, 243, 245)  # the scene's background colour (viewer.js)
+failures = []
+
+
+def check(condition, what):
+    print(("ok      " if condition else "FAILED  ") + what)
+    if not condition:
+        failures.append(what)
+
+
+def run(args):
+    r = subprocess.run(args, capture_output=True, text=True)
+    if r.returncode != 0:
+        raise RuntimeError(f"{' '.join(args)}: exit {r.returncode}: {r.stderr.strip()}")
+    return r.stdout
+
+
+def trajectory_result(rid, line, a, b, samples=21):
+    t = [i / (samples - 1) for i in range(samples)]
+    q = [[x + s * (y - x) for x, y in zip(a, b)] for s in t]
+    return {"id": rid, "line": line, "planner": "lazysp", "success": True,
+            "time_to_first_solution": 0.01, "n_solutions": 1, "best_cost": 1.0, "duration": 1.0,
+            "edges": [3, 5], "trajectory": {"t": t, "q": q, "dq": [[0] * 7] * samples}}
+
+
+def failed_result(rid, line, failure):
+    return {"id": rid, "line": line, "planner": "lazyboe", "success": False, "failure": failure,
+            "time_to_first_solution": None, "n_solutions": 0, "best_cost": None}
+
+
+def write_lines(path, rows):
+    with open(path, "w") as f:
+        for r in rows:
+            f.write(json.dumps(r) + "\n")
+    return path
+
+
+def page_state(browser):
+    return browser.evaluate("JSON.stringify(Object.assign({}, document.body.dataset))")
+
+
+def open_page(browser, path, name):
+    """Loads a page, waits for its scene; checks status and console. Returns its data-* state."""
+    browser.console_errors.clear()
+    browser.open(path)
+    ready = browser.wait_for("document.body.dataset.status !== 'loading'", 30)
+    state = json.loads(page_state(browser))
+    check(ready and state.get("status") == "ready", f"{name}: scene ready ({state.get('status')})")
+    check(state.get("errors") == "0", f"{name}: no script errors on the page")
+    check(not browser.console_errors, f"{name}: no console errors {browser.console_errors}")
+    return state
+
+
+def nonblank_robot(browser, png_path, name):
+    """The screenshot is not blank where the robot is: in the robot's box on the page, at least
+    a twentieth of the pixels differ from the same view with the robot (and its ghosts) hidden,
+    and from the background colour."""
+    box = browser.evaluate("lazyboeView.robotScreenBox()")
+    width, height, shown = chromium.read_png(browser.screenshot(png_path))
+    browser.evaluate("lazyboeView.showRobots(false)")
+    hidden = chromium.read_png(browser.screenshot(png_path + ".without-robot.png"))[2]
+    browser.evaluate("lazyboeView.showRobots(true)")
+    os.remove(png_path + ".without-robot.png")
+    x0, y0 = max(0, int(box["x0"])), max(0, int(box["y0"]))
+    x1, y1 = min(width, int(math.ceil(box["x1"]))), min(height, int(math.ceil(box["y1"])))
+    check(x1 - x0 > 20 and y1 - y0 > 20, f"{name}: robot's box on screen {box}")
+    far = lambda p, q: max(abs(a - b) for a, b in zip(p, q)) > 24  # noqa: E731
+    points = [(x, y) for y in range(y0, y1, 2) for x in range(x0, x1, 2)]
+    robot = sum(1 for x, y in points if far(shown[y][x], hidden[y][x]) and far(shown[y][x], BACKGROUND))
+    share = robot / max(1, len(points))
+    check(share > 0.05, f"{name}: the robot covers {share:.0%} of its box ({png_path})")
+
+
+def compare_fk(browser, bin_dir, configurations):
+    """Every link's pose in the page against lazyboe-robot fk, to 1e-6."""
+    worst = 0.0
+    for q in configurations:
+        page = browser.evaluate(f"lazyboeView.linkPoses({json.dumps(q)})")
+        for link in page:
+            tool = json.loads(run([os.path.join(bin_dir, "lazyboe-robot"), "fk", "--q",
+                                   ",".join(repr(v) for v in q), "--link", link["link"]]))
+            dp = max(abs(a - b) for a, b in zip(link["position"], tool["position"]))
+            sign = 1 if sum(a * b for a, b in zip(link["quaternion"], tool["quaternion"])) >= 0 else -1
+            dq = max(abs(sign * a - b) for a, b in zip(link["quaternion"], tool["quaternion"]))
+            worst = max(worst, dp, dq)
+    check(worst <= 1e-6, f"page forward kinematics = lazyboe-robot fk at {len(configurations)} "
+          f"configurations, every link (largest difference {worst:.1e})")
+
+
+def obstacles_in(env_path):
+    with open(env_path) as f:
+        env = json.load(f)
+    return len(env.get("obstacles", env.get("objects", [])))
+
+
+def main():
+    bin_dir, out_dir = sys.argv[1], sys.argv[2]
+    binary = chromium.find_chromium()
+    if not binary:
+        print("SKIPPED: Chromium is not installed (scripts/install-deps.sh installs Debian's chromium)")
+        return 77
+    os.makedirs(out_dir, exist_ok=True)
+    tool = os.path.join(bin_dir, "lazyboe-view")
+
+    # Inputs: three trajectories, one failed query, their queries, a small analysed bundle.
+    bundle = os.path.join(out_dir, "bundle.h5")
+    run([os.path.join(bin_dir, "lazyboe-build"), "--out", bundle, "--edges", "200", "--seed", "2",
+         "--force", "--quiet"])
+    run([os.path.join(bin_dir, "lazyboe-perturb"), "--bundle", bundle, "--perturbations", "2", "--quiet"])
+    results = write_lines(os.path.join(out_dir, "results.jsonl"), [
+        trajectory_result("a", 1, READY, OTHER), trajectory_result("b", 2, OTHER, THIRD),
+        trajectory_result("c", 3, THIRD, READY), failed_result("d", 4, "no bundle coverage of the goal")])
+    queries = write_lines(os.path.join(out_dir, "queries.jsonl"), [
+        {"id": i, "start": s, "goal": {"q": g, "tolerance": 0.1}}
+        for i, s, g in (("a", READY, OTHER), ("b", OTHER, THIRD), ("c", THIRD, READY), ("d", OTHER, READY))])
+    main_page = os.path.join(out_dir, "view.html")
+    run([tool, "--results", results, "--queries", queries, "--bundle", bundle, "--out", main_page])
+    only_failed = os.path.join(out_dir, "failed.html")
+    run([tool, "--results", write_lines(os.path.join(out_dir, "failed.jsonl"),
+                                        [failed_result("d", 4, "search exhausted")]),
+         "--queries", queries, "--out", only_failed])
+    no_trajectories = os.path.join(out_dir, "none.html")
+    bare = trajectory_result("a", 1, READY, OTHER)
+    del bare["trajectory"]
+    run([tool, "--results", write_lines(os.path.join(out_dir, "none.jsonl"), [bare]),
+         "--out", no_trajectories])
+
+    env = os.path.join(SOURCE, "data", "environments", "table.json")
+    with chromium.Chromium(binary, 960, 600) as browser:
+        state = open_page(browser, main_page, "main page")
+        check(state.get("trajectories") == "3" and state.get("failures") == "1",
+              f"main page: 3 trajectories and 1 failed query loaded ({state})")
+        check(int(state.get("robotShapes", 0)) > 0, "main page: robot shapes loaded")
+        check(state.get("obstacles") == str(obstacles_in(env)), "main page: every obstacle of table.json")
+        check(state.get("bundlePoints") == "400", "main page: 400 bundle points (200 edges)")
+        text = browser.evaluate("document.body.innerText")
+        check("no bundle coverage of the goal" in text, "main page: the failure reason is shown")
+        check("a (lazysp, line 1): success, cost 1.00, duration 1.00 s" in text and "edges 3 5" in text,
+              "main page: the selected trajectory's id, planner, line, cost, duration and edges are shown")
+        nonblank_robot(browser, os.path.join(out_dir, "viewer.png"), "main page")
+        rng = random.Random(17)
+        configurations = [READY, OTHER, THIRD] + [[rng.uniform(-2.5, 2.5) for _ in range(7)] for _ in range(2)]
+        compare_fk(browser, bin_dir, configurations)
+        browser.evaluate("lazyboeView.play()")
+        check(browser.wait_for("lazyboeView.frameStats().frames > 10", 20), "main page: plays (frames drawn)")
+        check(not browser.console_errors, f"main page: no console errors while playing {browser.console_errors}")
+        # The harness sees errors when there are some (so "no console errors" above means it).
+        browser.evaluate("console.error('probe'); setTimeout(() => { throw new Error('thrown probe'); }, 0)")
+        for _ in range(50):  # each call also collects the events that came meanwhile
+            if len(browser.console_errors) >= 2:
+                break
+            browser.evaluate("1")
+            time.sleep(0.02)
+        check(browser.wait_for("document.body.dataset.errors === '1' && !document.getElementById('errors').hidden", 5),
+              "an uncaught exception is shown on the page and counted in data-errors")
+        check(any("probe" in e for e in browser.console_errors) and
+              any("thrown probe" in e for e in browser.console_errors),
+              f"console errors and uncaught exceptions are caught by the test ({browser.console_errors})")
+        browser.console_errors.clear()
+
+        state = open_page(browser, only_failed, "failed-only page")
+        text = browser.evaluate("document.body.innerText")
+        check(state.get("failures") == "1" and "search exhausted" in text,
+              "failed-only page: the failure and its reason are shown")
+        check("No trajectories" in text, "failed-only page: says there is no trajectory")
+        nonblank_robot(browser, os.path.join(out_dir, "failed.png"), "failed-only page (start ghost)")
+
+        state = open_page(browser, no_trajectories, "no-trajectory page")
+        text = browser.evaluate("document.body.innerText")
+        check("carry no trajectory" in text and state.get("trajectories") == "0",
+              "no-trajectory page: says the results carry no trajectory")
+        nonblank_robot(browser, os.path.join(out_dir, "none.png"), "no-trajectory page")
+
+    print(f"{len(failures)} failed" if failures else "all passed")
+    return 1 if failures else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
