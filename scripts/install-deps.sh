@@ -14,6 +14,9 @@ packages=(
   # Optional for the build (lazyboe-bench skips what is missing, and says so), installed so
   # that the demo and the tests cover OMPL's planners and the benchmark figures.
   libompl-dev python3-matplotlib
+  # Optional for the build (lazyboe-build/-perturb run across MPI ranks with it; without it
+  # they say so when asked for MPI), installed so that the MPI tests run (issue 18).
+  libopenmpi-dev openmpi-bin
 )
 # Extra packages a caller asks for.
 packages+=("$@")

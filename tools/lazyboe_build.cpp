@@ -8,6 +8,7 @@
 
 #include "lazyboe/bundle/builder.h"
 #include "lazyboe/bundle/bundle_file.h"
+#include "lazyboe/bundle/checkpoint_journal.h"
 #include "lazyboe/bundle/inspect.h"
 #include "lazyboe/common/file_checks.h"
 #include "lazyboe/common/json_fields.h"
@@ -226,13 +227,36 @@ bool prepare_resume(Bundle& existing, const BuildOptions& o) {
   return true;
 }
 
+// What --resume found in the checkpoint journal beside the file.
+void report_replay(const JournalReplay& r, const Bundle& b, const BuildOptions& o) {
+  if (o.control.quiet) return;
+  if (!r.note.empty()) std::fprintf(stderr, "lazyboe-build: %s\n", r.note.c_str());
+  if (r.applied)
+    std::fprintf(stderr,
+                 "lazyboe-build: %s: %llu checkpoints from its journal applied (%zu edges)%s\n",
+                 o.out_path.c_str(), static_cast<unsigned long long>(r.records), b.size(),
+                 r.ignored_bytes ? "; a torn last checkpoint was dropped" : "");
+}
+
 // Builds (or resumes) the bundle until complete or interrupted; returns the exit status.
-int grow_bundle(const Simulator& sim, BuildOptions& o, Bundle& bundle) {
+int grow_bundle(const Simulator& sim, BuildOptions& o, Bundle& bundle,
+                BuildCheckpoints& checkpoints) {
   install_stop_handlers();
   o.control.stop_requested = stop_requested;
-  o.control.save_checkpoint = [&](const Bundle& b) { write_bundle(o.out_path, b); };
+  o.control.save_progress = [&](const Bundle& b, bool last) {
+    if (last) {
+      checkpoints.finish(b);
+    } else {
+      checkpoints.save(b);
+    }
+  };
+  CheckpointStats stats;
+  o.control.stats = &stats;
   const BuildOutcome outcome = build_bundle(sim, o.settings, bundle, o.control);
-  if (!o.control.quiet) print_summary(bundle);
+  if (!o.control.quiet) {
+    print_summary(bundle);
+    print_checkpoint_stats(stats, bundle.header.wall_seconds, stderr);
+  }
   if (outcome == BuildOutcome::Interrupted) {
     std::fprintf(stderr,
                  "lazyboe-build: interrupted; %s holds %zu edges. Continue with: lazyboe-build "
@@ -274,10 +298,13 @@ int run(const CLI::App& app, BuildOptions& o) {
   s.simulation.integrator = parse_integrator(o.integrator, "--integrator");
 
   Bundle existing;
+  BuildCheckpoints checkpoints(o.out_path);
   const bool exists = std::filesystem::exists(o.out_path);
   if (o.resume) {
     if (!exists) fail(o.out_path, "cannot resume: no such file");
-    existing = read_bundle(o.out_path);
+    JournalReplay replay;
+    existing = checkpoints.load(&replay);
+    report_replay(replay, existing, o);
     take_settings_from(app, existing.header, o);
   } else if (exists && !o.force) {
     fail(o.out_path, "already exists (use --force to overwrite, or --resume to continue it)");
@@ -303,7 +330,7 @@ int run(const CLI::App& app, BuildOptions& o) {
     if (!prepare_resume(existing, o)) return 0;
     bundle = std::move(existing);
   }
-  return grow_bundle(sim, o, bundle);
+  return grow_bundle(sim, o, bundle, checkpoints);
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 
 #include "lazyboe/bundle/builder.h"
 #include "lazyboe/bundle/bundle_file.h"
+#include "lazyboe/bundle/checkpoint_journal.h"
 #include "lazyboe/bundle/inspect.h"
 #include "lazyboe/bundle/perturbation.h"
 #include "tool_main.h"
@@ -65,21 +66,40 @@ int main(int argc, char** argv) {
                    "it with them\n",
                    bundle_path.c_str());
     }
-    if (bundle.perturbation.complete) {
+    PerturbCheckpoints checkpoints(bundle_path);
+    const JournalReplay replay = checkpoints.resume(bundle, s);
+    if (!control.quiet && !replay.note.empty())
+      std::fprintf(stderr, "lazyboe-perturb: %s\n", replay.note.c_str());
+    if (!control.quiet && replay.applied)
+      std::fprintf(stderr, "lazyboe-perturb: %s: %llu checkpoints from its journal applied%s\n",
+                   bundle_path.c_str(), static_cast<unsigned long long>(replay.records),
+                   replay.ignored_bytes ? "; a torn last checkpoint was dropped" : "");
+    if (bundle.perturbation.complete && !replay.applied) {
       if (!control.quiet) {
         std::fprintf(
             stderr, "lazyboe-perturb: %s already holds this analysis (theta %g, p = %llu)\n",
             bundle_path.c_str(), s.theta, static_cast<unsigned long long>(s.perturbations));
         print_perturbation_summary(bundle, stdout);
       }
-      write_bundle(bundle_path, bundle);  // p may have been raised to an equal value: keep in sync
+      checkpoints.finish(bundle);  // p may have been raised to an equal value: keep in sync
       return 0;
     }
     install_stop_handlers();
     control.stop_requested = stop_requested;
-    control.save_checkpoint = [&](const Bundle& b) { write_bundle(bundle_path, b); };
+    control.save_progress = [&](const Bundle& b, const std::vector<size_t>& edges, bool last) {
+      if (last) {
+        checkpoints.finish(b);
+      } else {
+        checkpoints.save(b, edges);
+      }
+    };
+    CheckpointStats stats;
+    control.stats = &stats;
     const PerturbOutcome outcome = run_perturbation(sim, bundle, s, control);
-    if (!control.quiet) print_perturbation_summary(bundle, stdout);
+    if (!control.quiet) {
+      print_perturbation_summary(bundle, stdout);
+      print_checkpoint_stats(stats, bundle.perturbation.wall_seconds, stderr);
+    }
     if (outcome == PerturbOutcome::Interrupted) {
       std::fprintf(
           stderr,

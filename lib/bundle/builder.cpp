@@ -191,12 +191,18 @@ BuildOutcome build_bundle(const Simulator& sim, const BuildSettings& settings, B
 
   Progress progress("lazyboe-build", settings.edges, control.quiet);
   const double wall_before = h.wall_seconds;
+  bool last = false;
   Checkpointer checkpoints(control.checkpoint_seconds, [&] {
     h.wall_seconds = wall_before + progress.elapsed();
-    if (control.save_checkpoint) control.save_checkpoint(bundle);
+    if (control.save_progress) {
+      control.save_progress(bundle, last);
+    } else if (control.save_checkpoint) {
+      control.save_checkpoint(bundle);
+    }
   });
   auto save = [&](bool complete) {
     h.complete = complete;
+    last = true;
     checkpoints.save_now();
   };
   auto status_line = [&]() { return "valid " + percent(h.valid, h.attempts); };
@@ -207,6 +213,7 @@ BuildOutcome build_bundle(const Simulator& sim, const BuildSettings& settings, B
     if (control.stop_requested && control.stop_requested()) {
       progress.finish();
       save(false);
+      if (control.stats) *control.stats = checkpoints.stats();
       return BuildOutcome::Interrupted;
     }
     const uint64_t first = h.attempts;
@@ -233,6 +240,7 @@ BuildOutcome build_bundle(const Simulator& sim, const BuildSettings& settings, B
   }
   progress.finish();
   save(true);
+  if (control.stats) *control.stats = checkpoints.stats();
   return BuildOutcome::Complete;
 }
 

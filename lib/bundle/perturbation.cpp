@@ -179,12 +179,22 @@ PerturbOutcome run_perturbation(const Simulator& sim, Bundle& b, const PerturbSe
   }
   Progress progress("lazyboe-perturb", n, control.quiet);
   const double wall_before = p.wall_seconds;
+  bool last = false;
+  size_t applied = 0, saved = 0;  // pending[0, applied) have their results in `p`
+  std::vector<size_t> since_save;
   Checkpointer checkpoints(control.checkpoint_seconds, [&] {
     p.wall_seconds = wall_before + progress.elapsed();
-    if (control.save_checkpoint) control.save_checkpoint(b);
+    if (control.save_progress) {
+      since_save.assign(pending.begin() + saved, pending.begin() + applied);
+      control.save_progress(b, since_save, last);
+      saved = applied;
+    } else if (control.save_checkpoint) {
+      control.save_checkpoint(b);
+    }
   });
   auto save = [&](bool complete) {
     p.complete = complete;
+    last = true;
     checkpoints.save_now();
   };
   size_t finished = n - pending.size();
@@ -196,6 +206,7 @@ PerturbOutcome run_perturbation(const Simulator& sim, Bundle& b, const PerturbSe
     if (control.stop_requested && control.stop_requested()) {
       progress.finish();
       save(false);
+      if (control.stats) *control.stats = checkpoints.stats();
       return PerturbOutcome::Interrupted;
     }
     const size_t count = std::min(round, pending.size() - start);
@@ -227,6 +238,7 @@ PerturbOutcome run_perturbation(const Simulator& sim, Bundle& b, const PerturbSe
       p.simulated_seconds += c.simulated_seconds;
       set_probabilities(p, e);
     }
+    applied = start + count;
     finished += count;
     progress.update(finished);
     if (control.progress) control.progress(finished, n);
@@ -234,6 +246,7 @@ PerturbOutcome run_perturbation(const Simulator& sim, Bundle& b, const PerturbSe
   }
   progress.finish();
   save(true);
+  if (control.stats) *control.stats = checkpoints.stats();
   return PerturbOutcome::Complete;
 }
 

@@ -15,6 +15,7 @@
 #include <functional>
 
 #include "lazyboe/bundle/bundle.h"
+#include "lazyboe/common/checkpoint.h"
 #include "lazyboe/sim/simulator.h"
 
 namespace lazyboe {
@@ -31,7 +32,11 @@ struct PerturbControl {
   bool quiet = false;
   std::function<bool()> stop_requested;
   std::function<void(const Bundle&)> save_checkpoint;
+  // Instead of save_checkpoint when set: `edges` were finished since the previous save; `last`
+  // is true for the run's last save (complete, or interrupted).
+  std::function<void(const Bundle&, const std::vector<size_t>& edges, bool last)> save_progress;
   std::function<void(uint64_t done, uint64_t total)> progress;  // finished edges, after each round
+  CheckpointStats* stats = nullptr;  // receives what the saves cost, when set
 };
 
 // Draws perturbation j of edge `edge` (norm in (0, theta]).
