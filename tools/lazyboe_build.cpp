@@ -13,6 +13,8 @@
 #include "lazyboe/common/file_checks.h"
 #include "lazyboe/common/json_fields.h"
 #include "lazyboe/common/version.h"
+#include "mpi_build.h"
+#include "mpi_offline.h"
 #include "tool_main.h"
 
 namespace {
@@ -86,8 +88,10 @@ struct BuildOptions {
   BuildSettings settings;
   BuildControl control;
   double sample_interval = 0.05;
-  bool resume = false, force = false;
+  bool resume = false, force = false, mpi = false;
 };
+
+bool g_job_sent = false;  // MPI: rank 0 has sent the other ranks their job
 
 void add_options(CLI::App& app, BuildOptions& o) {
   BuildSettings& s = o.settings;
@@ -141,6 +145,9 @@ void add_options(CLI::App& app, BuildOptions& o) {
   app.add_flag("--resume", o.resume, "Continue an interrupted build in --out (to --edges)");
   app.add_flag("--force", o.force, "Overwrite an existing --out");
   app.add_flag("--quiet", o.control.quiet, "No progress output");
+  app.add_flag("--mpi", o.mpi,
+               "Require MPI (run under mpirun or srun; without this flag MPI is used whenever "
+               "the tool is launched by one)");
   app.add_option("--inspect", o.inspect_path,
                  "Print the header and statistics of a bundle, then exit");
   app.add_option("--verify", o.verify_path,
@@ -252,7 +259,20 @@ int grow_bundle(const Simulator& sim, BuildOptions& o, Bundle& bundle,
   };
   CheckpointStats stats;
   o.control.stats = &stats;
+#ifdef LAZYBOE_HAVE_MPI
+  std::unique_ptr<AttemptGenerator> own_share;
+  if (mpi::world().active) {
+    std::string job = mpi::build_job(o.robot_path, o.env_path, bundle.header, o.settings);
+    mpi::broadcast(job);
+    g_job_sent = true;
+    own_share = std::make_unique<AttemptGenerator>(sim, o.settings, o.control.threads);
+    mpi::distribute_build(o.control, *own_share);
+  }
+#endif
   const BuildOutcome outcome = build_bundle(sim, o.settings, bundle, o.control);
+#ifdef LAZYBOE_HAVE_MPI
+  if (mpi::world().active) mpi::stop_build_ranks();
+#endif
   if (!o.control.quiet) {
     print_summary(bundle);
     print_checkpoint_stats(stats, bundle.header.wall_seconds, stderr);
@@ -341,5 +361,36 @@ int main(int argc, char** argv) {
   add_options(app, options);
   one_line_cli_errors(app, "lazyboe-build");
   CLI11_PARSE(app, argc, argv);
+  const int launched = mpi::launcher_world_size();
+#ifdef LAZYBOE_HAVE_MPI
+  if (launched > 0 || options.mpi) {
+    mpi::init(argc, argv);
+    if (mpi::world().rank != 0) {
+      try {
+        mpi::serve_build(options.control.threads);
+      } catch (const std::exception& e) {
+        mpi::abort_job("lazyboe-build", e.what());
+      }
+      mpi::finalize();
+      return 0;
+    }
+    const int code = run_tool("lazyboe-build", [&]() -> int { return run(app, options); });
+    if (code != 0 && code != 130) MPI_Abort(MPI_COMM_WORLD, code);  // the others wait for it
+    if (!g_job_sent) {
+      std::string nothing;
+      mpi::broadcast(nothing);
+    }
+    mpi::finalize();
+    return code;
+  }
+#else
+  if (options.mpi || launched > 1) {
+    std::fprintf(stderr,
+                 "lazyboe-build: error: %s, but this lazyboe-build was built without MPI "
+                 "(install libopenmpi-dev and rebuild)\n",
+                 options.mpi ? "--mpi given" : "launched by mpirun/srun with several ranks");
+    return 1;
+  }
+#endif
   return run_tool("lazyboe-build", [&]() -> int { return run(app, options); });
 }

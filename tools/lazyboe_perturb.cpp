@@ -8,11 +8,15 @@
 #include "lazyboe/bundle/checkpoint_journal.h"
 #include "lazyboe/bundle/inspect.h"
 #include "lazyboe/bundle/perturbation.h"
+#include "mpi_offline.h"
+#include "mpi_perturb.h"
 #include "tool_main.h"
 
 namespace {
 
 using namespace lazyboe;
+
+bool g_job_sent = false;  // MPI: rank 0 has sent the other ranks their job
 
 }  // namespace
 
@@ -21,7 +25,7 @@ int main(int argc, char** argv) {
   std::string bundle_path, robot_path, env_path;
   PerturbSettings s;
   PerturbControl control;
-  bool replace = false;
+  bool replace = false, use_mpi = false;
   app.add_option("--bundle", bundle_path, "Bundle file (HDF5), updated in place")->required();
   app.add_option("--theta", s.theta,
                  "Perturbation radius, rad (default: the bundle's design theta)")
@@ -42,10 +46,13 @@ int main(int argc, char** argv) {
       ->capture_default_str()
       ->check(number_at_least_zero());
   app.add_flag("--quiet", control.quiet, "No progress or summary output");
+  app.add_flag("--mpi", use_mpi,
+               "Require MPI (run under mpirun or srun; without this flag MPI is used whenever "
+               "the tool is launched by one)");
   one_line_cli_errors(app, "lazyboe-perturb");
   CLI11_PARSE(app, argc, argv);
 
-  return run_tool("lazyboe-perturb", [&]() -> int {
+  auto body = [&]() -> int {
     Bundle bundle = read_bundle(bundle_path);
     const BundleHeader& h = bundle.header;
     require_complete(h, bundle_path);
@@ -95,7 +102,20 @@ int main(int argc, char** argv) {
     };
     CheckpointStats stats;
     control.stats = &stats;
+#ifdef LAZYBOE_HAVE_MPI
+    std::unique_ptr<mpi::PerturbRanks> ranks;
+    if (mpi::world().active) {
+      std::string job = mpi::perturb_job(scene, h, s, options);
+      mpi::broadcast(job);
+      g_job_sent = true;
+      ranks = std::make_unique<mpi::PerturbRanks>(sim, bundle, s, control.threads);
+      ranks->attach(control);
+    }
+#endif
     const PerturbOutcome outcome = run_perturbation(sim, bundle, s, control);
+#ifdef LAZYBOE_HAVE_MPI
+    if (mpi::world().active) mpi::stop_perturb_ranks();
+#endif
     if (!control.quiet) {
       print_perturbation_summary(bundle, stdout);
       print_checkpoint_stats(stats, bundle.perturbation.wall_seconds, stderr);
@@ -111,5 +131,37 @@ int main(int argc, char** argv) {
       return 130;
     }
     return 0;
-  });
+  };
+  const int launched = mpi::launcher_world_size();
+#ifdef LAZYBOE_HAVE_MPI
+  if (launched > 0 || use_mpi) {
+    mpi::init(argc, argv);
+    if (mpi::world().rank != 0) {
+      try {
+        mpi::serve_perturb(control.threads);
+      } catch (const std::exception& e) {
+        mpi::abort_job("lazyboe-perturb", e.what());
+      }
+      mpi::finalize();
+      return 0;
+    }
+    const int code = run_tool("lazyboe-perturb", body);
+    if (code != 0 && code != 130) MPI_Abort(MPI_COMM_WORLD, code);  // the others wait for it
+    if (!g_job_sent) {
+      std::string nothing;
+      mpi::broadcast(nothing);
+    }
+    mpi::finalize();
+    return code;
+  }
+#else
+  if (use_mpi || launched > 1) {
+    std::fprintf(stderr,
+                 "lazyboe-perturb: error: %s, but this lazyboe-perturb was built without MPI "
+                 "(install libopenmpi-dev and rebuild)\n",
+                 use_mpi ? "--mpi given" : "launched by mpirun/srun with several ranks");
+    return 1;
+  }
+#endif
+  return run_tool("lazyboe-perturb", body);
 }
