@@ -246,6 +246,22 @@ TEST(Checkpoints, PerturbKilledAtTimedMomentsResumesToTheSameBytes) {
   }
 }
 
+// Past a file-size limit (as a full disk) inside a journal append: one line naming the journal;
+// the base and the whole records stay, and --resume (without the limit) finishes the build.
+TEST(Checkpoints, FullDiskInAJournalAppendKeepsEveryEarlierCheckpoint) {
+  const std::string dir = fresh_dir("full");
+  const std::string out = dir + "/run.h5";
+  std::vector<std::string> args = build_args(out, "0");
+  const CommandResult r = run("ulimit -f 300 && " + command("lazyboe-build", args));
+  EXPECT_EQ(r.exit_code, 1) << describe(r);
+  expect_one_line_error(r, {build_journal_path(out), "cannot write"});
+  EXPECT_NO_THROW(read_bundle(out));
+  EXPECT_GE(read_journal(build_journal_path(out)).records.size(), 2u);
+  const CommandResult resumed = tool("lazyboe-build", {"--resume", "--out", out, "--quiet"});
+  ASSERT_EQ(resumed.exit_code, 0) << describe(resumed);
+  EXPECT_TRUE(same_file_but_wall_seconds(out, reference_build(), 1));
+}
+
 // ---- the journal itself ----
 
 TEST(Journal, TornOrDamagedTailIsIgnoredAndCutOffOnReopen) {
