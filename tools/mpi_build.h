@@ -1,7 +1,7 @@
 // lazyboe-build across MPI ranks (mpi_offline.h): rank 0 runs the build; every round it
 // broadcasts (first attempt, attempts per rank), each rank r computes attempts
 // [first + r x per, first + (r + 1) x per) on its threads, and rank 0 gathers them in order.
-// Per valid edge about 1.5 kB travels to rank 0 (its states, knots and samples); per rejected
+// Per valid edge about 1.35 kB travels to rank 0 (its states, knots and samples); per rejected
 // attempt 24 bytes.
 #pragma once
 #ifdef LAZYBOE_HAVE_MPI

@@ -1,7 +1,7 @@
 // lazyboe-perturb across MPI ranks (mpi_offline.h): rank 0 holds the bundle; every round it
 // splits the round's edges into one contiguous block per rank, sends each rank its edges' data
-// (start and end state, command: about 0.6 kB per edge) with their counts so far, perturbs its
-// own block on its threads, and gathers the counts back (56 bytes per edge).
+// (start and end state, command: about 0.45 kB per edge) with their counts so far, perturbs its
+// own block on its threads, and gathers the counts back (64 bytes per edge).
 #pragma once
 #ifdef LAZYBOE_HAVE_MPI
 
