@@ -55,8 +55,10 @@ std::string command(int ranks, const std::string& tool, std::vector<std::string>
                     const std::string& env = "") {
   std::string cmd = env + " timeout -s KILL " + std::to_string(120 * time_scale()) + " ";
   if (ranks > 0) {
-    // As root (CI containers) mpirun needs --allow-run-as-root; two cores: --oversubscribe.
-    cmd += quote(kMpiexec) + " --allow-run-as-root --oversubscribe --bind-to none -np " +
+    // As root (CI containers) mpirun needs --allow-run-as-root; two cores: --oversubscribe;
+    // a container without ssh: plm_rsh_agent false (every rank is local).
+    cmd += quote(kMpiexec) +
+           " --allow-run-as-root --oversubscribe --bind-to none --mca plm_rsh_agent false -np " +
            std::to_string(ranks) + " ";
     args.insert(args.end(), {"--threads", "1"});
   } else {
@@ -144,13 +146,13 @@ TEST(Mpi, RankKilledMidBuildResumesWithAnotherRankCountToTheSameFile) {
   REQUIRE_MPI();
   const std::string out = fresh_dir("killed-build") + "/mpi.h5";
   const CommandResult r =
-      run(command(3, "lazyboe-build", build_args(out), "LAZYBOE_TEST_CRASH_AT=rank-round:4"));
+      run(command(3, "lazyboe-build", build_args(out), "LAZYBOE_TEST_CRASH_AT=rank-round:2"));
   ASSERT_NE(r.exit_code, 0) << "the job did not end when a rank died: " << describe(r);
   ASSERT_TRUE(fs::exists(out)) << describe(r);
   for (int ranks : {2, 0}) {  // resumed on 2 ranks, killed again, finished by one process
     std::vector<std::string> resume = {"--resume", "--out", out, "--quiet"};
     const CommandResult again = run(
-        command(ranks, "lazyboe-build", resume, ranks ? "LAZYBOE_TEST_CRASH_AT=rank-round:2" : ""));
+        command(ranks, "lazyboe-build", resume, ranks ? "LAZYBOE_TEST_CRASH_AT=rank-round:3" : ""));
     if (ranks) {
       EXPECT_NE(again.exit_code, 0) << describe(again);
     } else {
@@ -187,7 +189,8 @@ TEST(Mpi, AFailureOnOneRankEndsTheJobWithOneLine) {
   };
   const std::string cmd =
       "cd " + quote(here) + " && timeout -s KILL " + std::to_string(60 * time_scale()) + " " +
-      quote(kMpiexec) + " --allow-run-as-root --oversubscribe --bind-to none -np 1 " +
+      quote(kMpiexec) +
+      " --allow-run-as-root --oversubscribe --bind-to none --mca plm_rsh_agent false -np 1 " +
       args(here + "/run.h5") + " : -np 1 -wdir " + quote(there) + " " + args(here + "/run.h5");
   const CommandResult r = run(cmd);
   EXPECT_NE(r.exit_code, 0) << describe(r);

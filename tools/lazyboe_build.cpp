@@ -139,7 +139,7 @@ void add_options(CLI::App& app, BuildOptions& o) {
       ->capture_default_str()
       ->check(real_in({0, 1e3, true}, " rad"));
   app.add_option("--checkpoint-seconds", o.control.checkpoint_seconds,
-                 "Least time between checkpoints")
+                 "Least time between checkpoints (0: after every round)")
       ->capture_default_str()
       ->check(number_at_least_zero());
   app.add_flag("--resume", o.resume, "Continue an interrupted build in --out (to --edges)");
@@ -361,36 +361,7 @@ int main(int argc, char** argv) {
   add_options(app, options);
   one_line_cli_errors(app, "lazyboe-build");
   CLI11_PARSE(app, argc, argv);
-  const int launched = mpi::launcher_world_size();
-#ifdef LAZYBOE_HAVE_MPI
-  if (launched > 0 || options.mpi) {
-    mpi::init(argc, argv);
-    if (mpi::world().rank != 0) {
-      try {
-        mpi::serve_build(options.control.threads);
-      } catch (const std::exception& e) {
-        mpi::abort_job("lazyboe-build", e.what());
-      }
-      mpi::finalize();
-      return 0;
-    }
-    const int code = run_tool("lazyboe-build", [&]() -> int { return run(app, options); });
-    if (code != 0 && code != 130) MPI_Abort(MPI_COMM_WORLD, code);  // the others wait for it
-    if (!g_job_sent) {
-      std::string nothing;
-      mpi::broadcast(nothing);
-    }
-    mpi::finalize();
-    return code;
-  }
-#else
-  if (options.mpi || launched > 1) {
-    std::fprintf(stderr,
-                 "lazyboe-build: error: %s, but this lazyboe-build was built without MPI "
-                 "(install libopenmpi-dev and rebuild)\n",
-                 options.mpi ? "--mpi given" : "launched by mpirun/srun with several ranks");
-    return 1;
-  }
-#endif
-  return run_tool("lazyboe-build", [&]() -> int { return run(app, options); });
+  return mpi::run_tool_on_ranks(
+      "lazyboe-build", options.mpi, argc, argv, [&]() -> int { return run(app, options); },
+      [&] { mpi::serve_build(options.control.threads); }, g_job_sent);
 }

@@ -18,6 +18,15 @@ using namespace lazyboe;
 
 bool g_job_sent = false;  // MPI: rank 0 has sent the other ranks their job
 
+// What the checkpoint journal beside the bundle gave.
+void report_replay(const JournalReplay& replay, const std::string& path) {
+  if (!replay.note.empty()) std::fprintf(stderr, "lazyboe-perturb: %s\n", replay.note.c_str());
+  if (replay.applied)
+    std::fprintf(stderr, "lazyboe-perturb: %s: %llu checkpoints from its journal applied%s\n",
+                 path.c_str(), static_cast<unsigned long long>(replay.records),
+                 replay.ignored_bytes ? "; a torn last checkpoint was dropped" : "");
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -42,7 +51,7 @@ int main(int argc, char** argv) {
   app.add_option("--env", env_path, "Environment (default: the one the bundle was built with)");
   app.add_flag("--replace", replace, "Discard an existing analysis with other settings");
   app.add_option("--checkpoint-seconds", control.checkpoint_seconds,
-                 "Least time between checkpoints")
+                 "Least time between checkpoints (0: after every round)")
       ->capture_default_str()
       ->check(number_at_least_zero());
   app.add_flag("--quiet", control.quiet, "No progress or summary output");
@@ -75,12 +84,7 @@ int main(int argc, char** argv) {
     }
     PerturbCheckpoints checkpoints(bundle_path);
     const JournalReplay replay = checkpoints.resume(bundle, s);
-    if (!control.quiet && !replay.note.empty())
-      std::fprintf(stderr, "lazyboe-perturb: %s\n", replay.note.c_str());
-    if (!control.quiet && replay.applied)
-      std::fprintf(stderr, "lazyboe-perturb: %s: %llu checkpoints from its journal applied%s\n",
-                   bundle_path.c_str(), static_cast<unsigned long long>(replay.records),
-                   replay.ignored_bytes ? "; a torn last checkpoint was dropped" : "");
+    if (!control.quiet) report_replay(replay, bundle_path);
     if (bundle.perturbation.complete && !replay.applied) {
       if (!control.quiet) {
         std::fprintf(
@@ -103,18 +107,12 @@ int main(int argc, char** argv) {
     CheckpointStats stats;
     control.stats = &stats;
 #ifdef LAZYBOE_HAVE_MPI
-    std::unique_ptr<mpi::PerturbRanks> ranks;
-    if (mpi::world().active) {
-      std::string job = mpi::perturb_job(scene, h, s, options);
-      mpi::broadcast(job);
-      g_job_sent = true;
-      ranks = std::make_unique<mpi::PerturbRanks>(sim, bundle, s, control.threads);
-      ranks->attach(control);
-    }
+    const auto ranks = mpi::start_perturb_ranks(scene, sim, bundle, s, options, control);
+    g_job_sent = ranks != nullptr;
 #endif
     const PerturbOutcome outcome = run_perturbation(sim, bundle, s, control);
 #ifdef LAZYBOE_HAVE_MPI
-    if (mpi::world().active) mpi::stop_perturb_ranks();
+    if (ranks) mpi::stop_perturb_ranks();
 #endif
     if (!control.quiet) {
       print_perturbation_summary(bundle, stdout);
@@ -132,36 +130,7 @@ int main(int argc, char** argv) {
     }
     return 0;
   };
-  const int launched = mpi::launcher_world_size();
-#ifdef LAZYBOE_HAVE_MPI
-  if (launched > 0 || use_mpi) {
-    mpi::init(argc, argv);
-    if (mpi::world().rank != 0) {
-      try {
-        mpi::serve_perturb(control.threads);
-      } catch (const std::exception& e) {
-        mpi::abort_job("lazyboe-perturb", e.what());
-      }
-      mpi::finalize();
-      return 0;
-    }
-    const int code = run_tool("lazyboe-perturb", body);
-    if (code != 0 && code != 130) MPI_Abort(MPI_COMM_WORLD, code);  // the others wait for it
-    if (!g_job_sent) {
-      std::string nothing;
-      mpi::broadcast(nothing);
-    }
-    mpi::finalize();
-    return code;
-  }
-#else
-  if (use_mpi || launched > 1) {
-    std::fprintf(stderr,
-                 "lazyboe-perturb: error: %s, but this lazyboe-perturb was built without MPI "
-                 "(install libopenmpi-dev and rebuild)\n",
-                 use_mpi ? "--mpi given" : "launched by mpirun/srun with several ranks");
-    return 1;
-  }
-#endif
-  return run_tool("lazyboe-perturb", body);
+  return mpi::run_tool_on_ranks(
+      "lazyboe-perturb", use_mpi, argc, argv, body, [&] { mpi::serve_perturb(control.threads); },
+      g_job_sent);
 }

@@ -10,6 +10,7 @@
 // job with MPI_Abort, so no rank waits forever for a rank that is gone.
 #pragma once
 
+#include <cstdio>
 #include <cstdlib>
 #include <string>
 
@@ -122,3 +123,55 @@ inline std::string scatter(const std::vector<std::string>& parts) {
 
 }  // namespace lazyboe::mpi
 #endif
+
+#include "tool_main.h"
+
+namespace lazyboe::mpi {
+
+// The offline tools' main. Launched by mpirun/srun (or with --mpi): rank 0 runs `body` (the
+// tool, which sends the other ranks their job; `job_sent` says whether it did) and the other
+// ranks `serve`; a failure on any rank ends the job (abort_job). Built without MPI: refuses
+// --mpi or a launch with several ranks, in one line, and otherwise runs `body`.
+template <class Body, class Serve>
+int run_tool_on_ranks(const char* tool, bool mpi_required, int& argc, char**& argv, Body&& body,
+                      Serve&& serve, const bool& job_sent) {
+  const int launched = launcher_world_size();
+#ifdef LAZYBOE_HAVE_MPI
+  if (launched > 0 || mpi_required) {
+    init(argc, argv);
+    if (world().rank != 0) {
+      try {
+        serve();
+      } catch (const std::exception& e) {
+        abort_job(tool, e.what());
+      }
+      finalize();
+      return 0;
+    }
+    const int code = run_tool(tool, body);
+    if (code != 0 && code != 130) MPI_Abort(MPI_COMM_WORLD, code);  // the others wait for it
+    if (!job_sent) {
+      std::string nothing;  // rank 0 had nothing to do: the others end too
+      broadcast(nothing);
+    }
+    finalize();
+    return code;
+  }
+#else
+  (void)argc;
+  (void)argv;
+  (void)serve;
+  (void)job_sent;
+  if (mpi_required || launched > 1) {
+    std::fprintf(stderr,
+                 "%s: error: %s, but this %s was built without MPI (install libopenmpi-dev and "
+                 "rebuild)\n",
+                 tool, mpi_required ? "--mpi given" : "launched by mpirun/srun with several ranks",
+                 tool);
+    return 1;
+  }
+#endif
+  return run_tool(tool, body);
+}
+
+}  // namespace lazyboe::mpi

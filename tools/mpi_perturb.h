@@ -7,6 +7,7 @@
 
 #include <omp.h>
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -94,6 +95,20 @@ class PerturbRanks {
   int threads_;
   std::vector<SimulatorWorkspace> workspaces_;
 };
+
+// Rank 0 under MPI: sends the job and attaches the ranks to `control` (null without MPI).
+inline std::unique_ptr<PerturbRanks> start_perturb_ranks(const BundleScene& scene,
+                                                         const Simulator& sim, const Bundle& b,
+                                                         const PerturbSettings& s,
+                                                         const SimulationOptions& options,
+                                                         PerturbControl& control) {
+  if (!world().active) return nullptr;
+  std::string job = perturb_job(scene, b.header, s, options);
+  broadcast(job);
+  auto ranks = std::make_unique<PerturbRanks>(sim, b, s, control.threads);
+  ranks->attach(control);
+  return ranks;
+}
 
 inline void stop_perturb_ranks() {
   uint64_t go = 0;
