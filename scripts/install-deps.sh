@@ -17,6 +17,9 @@ packages=(
   # lazyboe-view (issue 17): three.js (with OrbitControls) inlined into its pages, and the
   # browser its tests open them in (headless; they are skipped without it).
   libjs-three chromium
+  # Optional for the build (lazyboe-build/-perturb run across MPI ranks with it; without it
+  # they say so when asked for MPI), installed so that the MPI tests run (issue 18).
+  libopenmpi-dev openmpi-bin
 )
 # Extra packages a caller asks for.
 packages+=("$@")

@@ -42,6 +42,8 @@
 #include "lazyboe/bundle/bundle.h"
 #include "lazyboe/bundle/bundle_file.h"
 #include "lazyboe/bundle/bundle_view.h"
+#include "lazyboe/bundle/checkpoint_journal.h"
+#include "lazyboe/bundle/perturbation.h"
 #include "test_util.h"
 
 extern char** environ;
@@ -150,8 +152,11 @@ bool wait_for_checkpoint(Background& b, const std::string& path, ino_t before,
       exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -WTERMSIG(status);
       return false;
     }
+    // A checkpoint: the journal beside the bundle (incremental checkpoints), or a rewritten
+    // bundle (the last save).
     const ino_t now = inode_of(path);
-    if (now != 0 && now != before) return true;
+    if ((now != 0 && now != before) || std::filesystem::exists(perturb_journal_path(path)))
+      return true;
     sleep_seconds(0.01);
   }
   return false;
@@ -837,9 +842,21 @@ TEST(PerturbCli, KilledRunLeavesAValidResumableBundle) {
   const std::string own_tmp = "run.h5.tmp." + std::to_string(pid);
   for (const std::string& f : tmp_files_in(dir)) EXPECT_EQ(f, own_tmp);
 
-  const Bundle partial = read_bundle(path);  // throws (fails the test) if the kill broke it
+  // The bundle is the one given (opens, same edges); the work so far is in its checkpoint
+  // journal, which applied to it gives a partial analysis.
+  Bundle partial = read_bundle(path);  // throws (fails the test) if the kill broke it
   expect_same_edges(partial, original);
-  ASSERT_TRUE(partial.perturbation.present);
+  EXPECT_EQ(partial.perturbation.present, original.perturbation.present);
+  ASSERT_TRUE(std::filesystem::exists(perturb_journal_path(path)));
+  PerturbSettings settings;
+  settings.perturbations = 16;
+  settings.theta = kLongTheta;
+  settings.seed = 5;
+  prepare_perturbation(partial, settings, false, path);
+  {
+    PerturbCheckpoints journal(path);
+    ASSERT_TRUE(journal.resume(partial, settings).applied);
+  }
   EXPECT_FALSE(partial.perturbation.complete);
   const size_t finished = check_invariants(partial);
   EXPECT_GT(finished, 0u);

@@ -8,10 +8,13 @@
 
 #include "lazyboe/bundle/builder.h"
 #include "lazyboe/bundle/bundle_file.h"
+#include "lazyboe/bundle/checkpoint_journal.h"
 #include "lazyboe/bundle/inspect.h"
 #include "lazyboe/common/file_checks.h"
 #include "lazyboe/common/json_fields.h"
 #include "lazyboe/common/version.h"
+#include "mpi_build.h"
+#include "mpi_offline.h"
 #include "tool_main.h"
 
 namespace {
@@ -85,8 +88,10 @@ struct BuildOptions {
   BuildSettings settings;
   BuildControl control;
   double sample_interval = 0.05;
-  bool resume = false, force = false;
+  bool resume = false, force = false, mpi = false;
 };
+
+bool g_job_sent = false;  // MPI: rank 0 has sent the other ranks their job
 
 void add_options(CLI::App& app, BuildOptions& o) {
   BuildSettings& s = o.settings;
@@ -134,12 +139,15 @@ void add_options(CLI::App& app, BuildOptions& o) {
       ->capture_default_str()
       ->check(real_in({0, 1e3, true}, " rad"));
   app.add_option("--checkpoint-seconds", o.control.checkpoint_seconds,
-                 "Least time between checkpoints")
+                 "Least time between checkpoints (0: after every round)")
       ->capture_default_str()
       ->check(number_at_least_zero());
   app.add_flag("--resume", o.resume, "Continue an interrupted build in --out (to --edges)");
   app.add_flag("--force", o.force, "Overwrite an existing --out");
   app.add_flag("--quiet", o.control.quiet, "No progress output");
+  app.add_flag("--mpi", o.mpi,
+               "Require MPI (run under mpirun or srun; without this flag MPI is used whenever "
+               "the tool is launched by one)");
   app.add_option("--inspect", o.inspect_path,
                  "Print the header and statistics of a bundle, then exit");
   app.add_option("--verify", o.verify_path,
@@ -226,13 +234,49 @@ bool prepare_resume(Bundle& existing, const BuildOptions& o) {
   return true;
 }
 
+// What --resume found in the checkpoint journal beside the file.
+void report_replay(const JournalReplay& r, const Bundle& b, const BuildOptions& o) {
+  if (o.control.quiet) return;
+  if (!r.note.empty()) std::fprintf(stderr, "lazyboe-build: %s\n", r.note.c_str());
+  if (r.applied)
+    std::fprintf(stderr,
+                 "lazyboe-build: %s: %llu checkpoints from its journal applied (%zu edges)%s\n",
+                 o.out_path.c_str(), static_cast<unsigned long long>(r.records), b.size(),
+                 r.ignored_bytes ? "; a torn last checkpoint was dropped" : "");
+}
+
 // Builds (or resumes) the bundle until complete or interrupted; returns the exit status.
-int grow_bundle(const Simulator& sim, BuildOptions& o, Bundle& bundle) {
+int grow_bundle(const Simulator& sim, BuildOptions& o, Bundle& bundle,
+                BuildCheckpoints& checkpoints) {
   install_stop_handlers();
   o.control.stop_requested = stop_requested;
-  o.control.save_checkpoint = [&](const Bundle& b) { write_bundle(o.out_path, b); };
+  o.control.save_progress = [&](const Bundle& b, bool last) {
+    if (last) {
+      checkpoints.finish(b);
+    } else {
+      checkpoints.save(b);
+    }
+  };
+  CheckpointStats stats;
+  o.control.stats = &stats;
+#ifdef LAZYBOE_HAVE_MPI
+  std::unique_ptr<AttemptGenerator> own_share;
+  if (mpi::world().active) {
+    std::string job = mpi::build_job(o.robot_path, o.env_path, bundle.header, o.settings);
+    mpi::broadcast(job);
+    g_job_sent = true;
+    own_share = std::make_unique<AttemptGenerator>(sim, o.settings, o.control.threads);
+    mpi::distribute_build(o.control, *own_share);
+  }
+#endif
   const BuildOutcome outcome = build_bundle(sim, o.settings, bundle, o.control);
-  if (!o.control.quiet) print_summary(bundle);
+#ifdef LAZYBOE_HAVE_MPI
+  if (mpi::world().active) mpi::stop_build_ranks();
+#endif
+  if (!o.control.quiet) {
+    print_summary(bundle);
+    print_checkpoint_stats(stats, bundle.header.wall_seconds, stderr);
+  }
   if (outcome == BuildOutcome::Interrupted) {
     std::fprintf(stderr,
                  "lazyboe-build: interrupted; %s holds %zu edges. Continue with: lazyboe-build "
@@ -274,10 +318,13 @@ int run(const CLI::App& app, BuildOptions& o) {
   s.simulation.integrator = parse_integrator(o.integrator, "--integrator");
 
   Bundle existing;
+  BuildCheckpoints checkpoints(o.out_path);
   const bool exists = std::filesystem::exists(o.out_path);
   if (o.resume) {
     if (!exists) fail(o.out_path, "cannot resume: no such file");
-    existing = read_bundle(o.out_path);
+    JournalReplay replay;
+    existing = checkpoints.load(&replay);
+    report_replay(replay, existing, o);
     take_settings_from(app, existing.header, o);
   } else if (exists && !o.force) {
     fail(o.out_path, "already exists (use --force to overwrite, or --resume to continue it)");
@@ -303,7 +350,7 @@ int run(const CLI::App& app, BuildOptions& o) {
     if (!prepare_resume(existing, o)) return 0;
     bundle = std::move(existing);
   }
-  return grow_bundle(sim, o, bundle);
+  return grow_bundle(sim, o, bundle, checkpoints);
 }
 
 }  // namespace
@@ -314,5 +361,7 @@ int main(int argc, char** argv) {
   add_options(app, options);
   one_line_cli_errors(app, "lazyboe-build");
   CLI11_PARSE(app, argc, argv);
-  return run_tool("lazyboe-build", [&]() -> int { return run(app, options); });
+  return mpi::run_tool_on_ranks(
+      "lazyboe-build", options.mpi, argc, argv, [&]() -> int { return run(app, options); },
+      [&] { mpi::serve_build(options.control.threads); }, g_job_sent);
 }

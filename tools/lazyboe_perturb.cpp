@@ -5,13 +5,27 @@
 
 #include "lazyboe/bundle/builder.h"
 #include "lazyboe/bundle/bundle_file.h"
+#include "lazyboe/bundle/checkpoint_journal.h"
 #include "lazyboe/bundle/inspect.h"
 #include "lazyboe/bundle/perturbation.h"
+#include "mpi_offline.h"
+#include "mpi_perturb.h"
 #include "tool_main.h"
 
 namespace {
 
 using namespace lazyboe;
+
+bool g_job_sent = false;  // MPI: rank 0 has sent the other ranks their job
+
+// What the checkpoint journal beside the bundle gave.
+void report_replay(const JournalReplay& replay, const std::string& path) {
+  if (!replay.note.empty()) std::fprintf(stderr, "lazyboe-perturb: %s\n", replay.note.c_str());
+  if (replay.applied)
+    std::fprintf(stderr, "lazyboe-perturb: %s: %llu checkpoints from its journal applied%s\n",
+                 path.c_str(), static_cast<unsigned long long>(replay.records),
+                 replay.ignored_bytes ? "; a torn last checkpoint was dropped" : "");
+}
 
 }  // namespace
 
@@ -20,7 +34,7 @@ int main(int argc, char** argv) {
   std::string bundle_path, robot_path, env_path;
   PerturbSettings s;
   PerturbControl control;
-  bool replace = false;
+  bool replace = false, use_mpi = false;
   app.add_option("--bundle", bundle_path, "Bundle file (HDF5), updated in place")->required();
   app.add_option("--theta", s.theta,
                  "Perturbation radius, rad (default: the bundle's design theta)")
@@ -37,14 +51,17 @@ int main(int argc, char** argv) {
   app.add_option("--env", env_path, "Environment (default: the one the bundle was built with)");
   app.add_flag("--replace", replace, "Discard an existing analysis with other settings");
   app.add_option("--checkpoint-seconds", control.checkpoint_seconds,
-                 "Least time between checkpoints")
+                 "Least time between checkpoints (0: after every round)")
       ->capture_default_str()
       ->check(number_at_least_zero());
   app.add_flag("--quiet", control.quiet, "No progress or summary output");
+  app.add_flag("--mpi", use_mpi,
+               "Require MPI (run under mpirun or srun; without this flag MPI is used whenever "
+               "the tool is launched by one)");
   one_line_cli_errors(app, "lazyboe-perturb");
   CLI11_PARSE(app, argc, argv);
 
-  return run_tool("lazyboe-perturb", [&]() -> int {
+  auto body = [&]() -> int {
     Bundle bundle = read_bundle(bundle_path);
     const BundleHeader& h = bundle.header;
     require_complete(h, bundle_path);
@@ -65,21 +82,42 @@ int main(int argc, char** argv) {
                    "it with them\n",
                    bundle_path.c_str());
     }
-    if (bundle.perturbation.complete) {
+    PerturbCheckpoints checkpoints(bundle_path);
+    const JournalReplay replay = checkpoints.resume(bundle, s);
+    if (!control.quiet) report_replay(replay, bundle_path);
+    if (bundle.perturbation.complete && !replay.applied) {
       if (!control.quiet) {
         std::fprintf(
             stderr, "lazyboe-perturb: %s already holds this analysis (theta %g, p = %llu)\n",
             bundle_path.c_str(), s.theta, static_cast<unsigned long long>(s.perturbations));
         print_perturbation_summary(bundle, stdout);
       }
-      write_bundle(bundle_path, bundle);  // p may have been raised to an equal value: keep in sync
+      checkpoints.finish(bundle);  // p may have been raised to an equal value: keep in sync
       return 0;
     }
     install_stop_handlers();
     control.stop_requested = stop_requested;
-    control.save_checkpoint = [&](const Bundle& b) { write_bundle(bundle_path, b); };
+    control.save_progress = [&](const Bundle& b, const std::vector<size_t>& edges, bool last) {
+      if (last) {
+        checkpoints.finish(b);
+      } else {
+        checkpoints.save(b, edges);
+      }
+    };
+    CheckpointStats stats;
+    control.stats = &stats;
+#ifdef LAZYBOE_HAVE_MPI
+    const auto ranks = mpi::start_perturb_ranks(scene, sim, bundle, s, options, control);
+    g_job_sent = ranks != nullptr;
+#endif
     const PerturbOutcome outcome = run_perturbation(sim, bundle, s, control);
-    if (!control.quiet) print_perturbation_summary(bundle, stdout);
+#ifdef LAZYBOE_HAVE_MPI
+    if (ranks) mpi::stop_perturb_ranks();
+#endif
+    if (!control.quiet) {
+      print_perturbation_summary(bundle, stdout);
+      print_checkpoint_stats(stats, bundle.perturbation.wall_seconds, stderr);
+    }
     if (outcome == PerturbOutcome::Interrupted) {
       std::fprintf(
           stderr,
@@ -91,5 +129,8 @@ int main(int argc, char** argv) {
       return 130;
     }
     return 0;
-  });
+  };
+  return mpi::run_tool_on_ranks(
+      "lazyboe-perturb", use_mpi, argc, argv, body, [&] { mpi::serve_perturb(control.threads); },
+      g_job_sent);
 }

@@ -81,6 +81,19 @@ void generate_edge(const Simulator& sim, SimulatorWorkspace& ws, const BuildSett
   out.duration = r.duration;
 }
 
+AttemptGenerator::AttemptGenerator(const Simulator& sim, const BuildSettings& settings, int threads)
+    : sim_(sim), settings_(settings), threads_(threads > 0 ? threads : omp_get_max_threads()) {
+  workspaces_.reserve(threads_);
+  for (int t = 0; t < threads_; ++t) workspaces_.emplace_back(sim);
+}
+
+void AttemptGenerator::generate(uint64_t first, size_t count, EdgeAttempt* out) {
+#pragma omp parallel for num_threads(threads_) schedule(dynamic, 1)
+  for (long k = 0; k < static_cast<long>(count); ++k) {
+    generate_edge(sim_, workspaces_[omp_get_thread_num()], settings_, first + k, out[k]);
+  }
+}
+
 Bundle new_bundle(const RobotModel& robot, const Environment& env, const BuildSettings& s) {
   Bundle b;
   BundleHeader& h = b.header;
@@ -182,21 +195,28 @@ void check_region(const Simulator& sim, const BuildSettings& settings) {
 BuildOutcome build_bundle(const Simulator& sim, const BuildSettings& settings, Bundle& bundle,
                           const BuildControl& control) {
   BundleHeader& h = bundle.header;
-  const int threads = control.threads > 0 ? control.threads : omp_get_max_threads();
-  const size_t round_size = std::max<size_t>(64, 32 * static_cast<size_t>(threads));
+  const bool local = !control.run_round;
+  AttemptGenerator generator(sim, settings, local ? control.threads : 1);
+  const size_t round_size =
+      local ? std::max<size_t>(64, 32 * static_cast<size_t>(generator.threads()))
+            : control.round_attempts;
+  if (round_size == 0) fail("build_bundle", "round_attempts must be > 0");
   std::vector<EdgeAttempt> results(round_size);
-  std::vector<SimulatorWorkspace> workspaces;
-  workspaces.reserve(threads);
-  for (int t = 0; t < threads; ++t) workspaces.emplace_back(sim);
 
   Progress progress("lazyboe-build", settings.edges, control.quiet);
   const double wall_before = h.wall_seconds;
+  bool last = false;
   Checkpointer checkpoints(control.checkpoint_seconds, [&] {
     h.wall_seconds = wall_before + progress.elapsed();
-    if (control.save_checkpoint) control.save_checkpoint(bundle);
+    if (control.save_progress) {
+      control.save_progress(bundle, last);
+    } else if (control.save_checkpoint) {
+      control.save_checkpoint(bundle);
+    }
   });
   auto save = [&](bool complete) {
     h.complete = complete;
+    last = true;
     checkpoints.save_now();
   };
   auto status_line = [&]() { return "valid " + percent(h.valid, h.attempts); };
@@ -207,12 +227,14 @@ BuildOutcome build_bundle(const Simulator& sim, const BuildSettings& settings, B
     if (control.stop_requested && control.stop_requested()) {
       progress.finish();
       save(false);
+      if (control.stats) *control.stats = checkpoints.stats();
       return BuildOutcome::Interrupted;
     }
     const uint64_t first = h.attempts;
-#pragma omp parallel for num_threads(threads) schedule(dynamic, 1)
-    for (long k = 0; k < static_cast<long>(round_size); ++k) {
-      generate_edge(sim, workspaces[omp_get_thread_num()], settings, first + k, results[k]);
+    if (local) {
+      generator.generate(first, round_size, results.data());
+    } else {
+      control.run_round(first, results);
     }
     // Take results in attempt order, up to the attempt that completes the bundle.
     for (size_t k = 0; k < round_size && bundle.size() < settings.edges; ++k) {
@@ -233,6 +255,7 @@ BuildOutcome build_bundle(const Simulator& sim, const BuildSettings& settings, B
   }
   progress.finish();
   save(true);
+  if (control.stats) *control.stats = checkpoints.stats();
   return BuildOutcome::Complete;
 }
 

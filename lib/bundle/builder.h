@@ -12,19 +12,10 @@
 #include "lazyboe/bundle/bundle.h"
 #include "lazyboe/bundle/scene.h"
 #include "lazyboe/bundle/settings.h"
+#include "lazyboe/common/checkpoint.h"
 #include "lazyboe/sim/simulator.h"
 
 namespace lazyboe {
-
-// How the build runs, not what it makes.
-struct BuildControl {
-  int threads = 0;                 // 0: all available
-  double checkpoint_seconds = 10;  // at least this long between checkpoints
-  bool quiet = false;
-  std::function<bool()> stop_requested;                         // polled between rounds
-  std::function<void(const Bundle&)> save_checkpoint;           // persists the bundle so far
-  std::function<void(uint64_t done, uint64_t total)> progress;  // valid edges, after each round
-};
 
 struct EdgeAttempt {
   RolloutStatus status = RolloutStatus::Valid;
@@ -38,10 +29,44 @@ struct EdgeAttempt {
   const char* reason() const;
 };
 
+// How the build runs, not what it makes.
+struct BuildControl {
+  int threads = 0;                 // 0: all available
+  double checkpoint_seconds = 10;  // at least this long between checkpoints
+  bool quiet = false;
+  std::function<bool()> stop_requested;                // polled between rounds
+  std::function<void(const Bundle&)> save_checkpoint;  // persists the bundle so far
+  // Instead of save_checkpoint when set: `last` is true for the run's last save (complete, or
+  // interrupted), so that checkpoints can be incremental (checkpoint_journal.h).
+  std::function<void(const Bundle&, bool last)> save_progress;
+  std::function<void(uint64_t done, uint64_t total)> progress;  // valid edges, after each round
+  CheckpointStats* stats = nullptr;  // receives what the saves cost, when set
+  // Where a round's attempts are computed. Unset: here, on `threads` threads, rounds of
+  // max(64, 32 x threads) attempts. Set (MPI, tools/mpi_offline.h): round_attempts per round,
+  // and run_round(first, results) fills results[k] with attempt first + k for every k.
+  size_t round_attempts = 0;
+  std::function<void(uint64_t first, std::vector<EdgeAttempt>& results)> run_round;
+};
+
 constexpr int kMaxStartSamples = 1000;  // per attempt, before it counts as start_in_collision
 
 void generate_edge(const Simulator& sim, SimulatorWorkspace& ws, const BuildSettings& settings,
                    uint64_t attempt, EdgeAttempt& out);
+
+// Attempts in parallel on a fixed set of threads, each with its own workspace.
+class AttemptGenerator {
+ public:
+  AttemptGenerator(const Simulator& sim, const BuildSettings& settings, int threads);
+  int threads() const { return threads_; }
+  // out[k] = attempt first + k, for k < count.
+  void generate(uint64_t first, size_t count, EdgeAttempt* out);
+
+ private:
+  const Simulator& sim_;
+  const BuildSettings& settings_;
+  int threads_;
+  std::vector<SimulatorWorkspace> workspaces_;
+};
 
 // A new, empty bundle whose header describes the inputs and settings.
 Bundle new_bundle(const RobotModel& robot, const Environment& env, const BuildSettings& settings);

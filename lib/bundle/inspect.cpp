@@ -133,6 +133,15 @@ void print_build_summary(const BundleHeader& h, std::FILE* out) {
                h.wall_seconds > 0 ? h.valid / h.wall_seconds : 0.0);
 }
 
+void print_checkpoint_stats(const CheckpointStats& s, double wall_seconds, std::FILE* out) {
+  std::fprintf(out,
+               "  checkpoints %llu in %.3f s (%.2f%% of %.1f s wall; longest %.3f s), last save "
+               "%.3f s\n",
+               static_cast<unsigned long long>(s.checkpoints), s.checkpoint_seconds,
+               wall_seconds > 0 ? 100.0 * s.checkpoint_seconds / wall_seconds : 0.0, wall_seconds,
+               s.longest_checkpoint_seconds, s.last_save_seconds);
+}
+
 std::string checksum_summary(const std::vector<DatasetVerification>& checks) {
   size_t verified = 0, missing = 0;
   std::string bad;

@@ -8,6 +8,7 @@
 
 #include "lazyboe/bundle/bundle.h"
 #include "lazyboe/bundle/bundle_file.h"
+#include "lazyboe/common/checkpoint.h"
 
 namespace lazyboe {
 
@@ -33,5 +34,9 @@ void print_transfer_summary(const Bundle& bundle, std::FILE* out);
 // Edge starts within `theta` (Euclidean, joint space) of random points of the sampling region:
 // the design check that a bundle holds enough neighbours for the planner.
 std::vector<double> neighbour_counts(const Bundle& bundle, double theta, int points, uint64_t seed);
+
+// One line: how many checkpoints the run wrote and what they and the last save cost, with the
+// checkpoints' share of `wall_seconds` (the bundle's or analysis's total wall time).
+void print_checkpoint_stats(const CheckpointStats& stats, double wall_seconds, std::FILE* out);
 
 }  // namespace lazyboe

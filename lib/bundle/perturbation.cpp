@@ -88,9 +88,38 @@ PerturbationSample perturb_sample(const Simulator& sim, SimulatorWorkspace& ws, 
 
 void perturb_edge(const Simulator& sim, SimulatorWorkspace& ws, const Bundle& b, size_t e,
                   const PerturbSettings& s, EdgePerturbationCounts& c) {
-  const EdgeInputs in = edge_inputs(b, e);
+  const int n = b.dof();
+  EdgeCommand command;
+  command.q0 = &b.q0[e * n];
+  command.qf = &b.qf[e * n];
+  command.knots = &b.knots[b.knot_offset[e] * n];
+  command.knot_rows = static_cast<int>(b.knot_offset[e + 1] - b.knot_offset[e]);
+  command.command_duration = b.command_duration[e];
+  perturb_edge_command(sim, ws, n, command, e, s, c);
+}
+
+EdgePerturbationCounts counts_so_far(const Perturbation& p, size_t e) {
+  EdgePerturbationCounts c;
+  c.done = p.done[e];
+  c.valid = p.valid[e];
+  c.lazy = p.lazy[e];
+  c.collision = p.collision[e];
+  c.max_error = p.valid[e] ? p.max_error[e] : 0.0;
+  c.transfer_lazy = p.transfer_lazy[e];
+  c.transfer_max_error = p.valid[e] ? p.transfer_max_error[e] : 0.0;
+  c.simulated_seconds = 0;
+  return c;
+}
+
+void perturb_edge_command(const Simulator& sim, SimulatorWorkspace& ws, int dof,
+                          const EdgeCommand& command, uint64_t e, const PerturbSettings& s,
+                          EdgePerturbationCounts& c) {
+  const EdgeInputs in{
+      Eigen::Map<const Eigen::VectorXd>(command.q0, dof),
+      Eigen::Map<const Eigen::VectorXd>(command.qf, dof),
+      CommandProfile{command.knots, command.knot_rows, dof, command.command_duration}};
   for (uint64_t j = c.done; j < s.perturbations; ++j) {
-    const PerturbationSample r = sample(sim, ws, in, s, b.dof(), e, j, &c.simulated_seconds);
+    const PerturbationSample r = sample(sim, ws, in, s, dof, e, j, &c.simulated_seconds);
     ++c.done;
     if (r.status == RolloutStatus::SelfCollision || r.status == RolloutStatus::EnvCollision) {
       ++c.collision;
@@ -167,7 +196,8 @@ PerturbOutcome run_perturbation(const Simulator& sim, Bundle& b, const PerturbSe
   const size_t n = b.size();
   if (!p.present || !p.has_transfer)
     fail("run_perturbation", "the analysis is not prepared (call prepare_perturbation first)");
-  const int threads = control.threads > 0 ? control.threads : omp_get_max_threads();
+  const bool local = !control.run_round;
+  const int threads = !local ? 1 : control.threads > 0 ? control.threads : omp_get_max_threads();
   std::vector<SimulatorWorkspace> workspaces;
   workspaces.reserve(threads);
   for (int t = 0; t < threads; ++t) workspaces.emplace_back(sim);
@@ -179,39 +209,52 @@ PerturbOutcome run_perturbation(const Simulator& sim, Bundle& b, const PerturbSe
   }
   Progress progress("lazyboe-perturb", n, control.quiet);
   const double wall_before = p.wall_seconds;
+  bool last = false;
+  size_t applied = 0, saved = 0;  // pending[0, applied) have their results in `p`
+  std::vector<size_t> since_save;
   Checkpointer checkpoints(control.checkpoint_seconds, [&] {
     p.wall_seconds = wall_before + progress.elapsed();
-    if (control.save_checkpoint) control.save_checkpoint(b);
+    if (control.save_progress) {
+      since_save.assign(pending.begin() + saved, pending.begin() + applied);
+      control.save_progress(b, since_save, last);
+      saved = applied;
+    } else if (control.save_checkpoint) {
+      control.save_checkpoint(b);
+    }
   });
   auto save = [&](bool complete) {
     p.complete = complete;
+    last = true;
     checkpoints.save_now();
   };
   size_t finished = n - pending.size();
-  const size_t round = std::max<size_t>(16, 8 * static_cast<size_t>(threads));
+  const size_t round =
+      local ? std::max<size_t>(16, 8 * static_cast<size_t>(threads)) : control.round_edges;
+  if (round == 0) fail("run_perturbation", "round_edges must be > 0");
   std::vector<EdgePerturbationCounts> counts(round);
+  std::vector<size_t> round_list;
   progress.update(finished);
   if (control.progress) control.progress(finished, n);
   for (size_t start = 0; start < pending.size(); start += round) {
     if (control.stop_requested && control.stop_requested()) {
       progress.finish();
       save(false);
+      if (control.stats) *control.stats = checkpoints.stats();
       return PerturbOutcome::Interrupted;
     }
     const size_t count = std::min(round, pending.size() - start);
+    if (local) {
 #pragma omp parallel for num_threads(threads) schedule(dynamic, 1)
-    for (long k = 0; k < static_cast<long>(count); ++k) {
-      const size_t e = pending[start + k];
-      EdgePerturbationCounts& c = counts[k];
-      c.done = p.done[e];
-      c.valid = p.valid[e];
-      c.lazy = p.lazy[e];
-      c.collision = p.collision[e];
-      c.max_error = p.valid[e] ? p.max_error[e] : 0.0;
-      c.transfer_lazy = p.transfer_lazy[e];
-      c.transfer_max_error = p.valid[e] ? p.transfer_max_error[e] : 0.0;
-      c.simulated_seconds = 0;
-      perturb_edge(sim, workspaces[omp_get_thread_num()], b, e, s, c);
+      for (long k = 0; k < static_cast<long>(count); ++k) {
+        const size_t e = pending[start + k];
+        counts[k] = counts_so_far(p, e);
+        perturb_edge(sim, workspaces[omp_get_thread_num()], b, e, s, counts[k]);
+      }
+    } else {
+      round_list.assign(pending.begin() + start, pending.begin() + start + count);
+      counts.resize(count);
+      for (size_t k = 0; k < count; ++k) counts[k] = counts_so_far(p, round_list[k]);
+      control.run_round(round_list, counts);
     }
     for (size_t k = 0; k < count; ++k) {
       const size_t e = pending[start + k];
@@ -227,6 +270,7 @@ PerturbOutcome run_perturbation(const Simulator& sim, Bundle& b, const PerturbSe
       p.simulated_seconds += c.simulated_seconds;
       set_probabilities(p, e);
     }
+    applied = start + count;
     finished += count;
     progress.update(finished);
     if (control.progress) control.progress(finished, n);
@@ -234,6 +278,7 @@ PerturbOutcome run_perturbation(const Simulator& sim, Bundle& b, const PerturbSe
   }
   progress.finish();
   save(true);
+  if (control.stats) *control.stats = checkpoints.stats();
   return PerturbOutcome::Complete;
 }
 

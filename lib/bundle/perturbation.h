@@ -15,6 +15,7 @@
 #include <functional>
 
 #include "lazyboe/bundle/bundle.h"
+#include "lazyboe/common/checkpoint.h"
 #include "lazyboe/sim/simulator.h"
 
 namespace lazyboe {
@@ -25,13 +26,25 @@ struct PerturbSettings {
   uint64_t seed = 1;
 };
 
+struct EdgePerturbationCounts;
+
 struct PerturbControl {
   int threads = 0;
   double checkpoint_seconds = 10;
   bool quiet = false;
   std::function<bool()> stop_requested;
   std::function<void(const Bundle&)> save_checkpoint;
+  // Instead of save_checkpoint when set: `edges` were finished since the previous save; `last`
+  // is true for the run's last save (complete, or interrupted).
+  std::function<void(const Bundle&, const std::vector<size_t>& edges, bool last)> save_progress;
   std::function<void(uint64_t done, uint64_t total)> progress;  // finished edges, after each round
+  CheckpointStats* stats = nullptr;  // receives what the saves cost, when set
+  // Where a round's edges are perturbed. Unset: here, on `threads` threads, rounds of
+  // max(16, 8 x threads) edges. Set (MPI, tools/mpi_offline.h): round_edges per round, and
+  // run_round(edges, counts) completes counts[k] (holding edge edges[k]'s counts so far).
+  size_t round_edges = 0;
+  std::function<void(const std::vector<size_t>& edges, std::vector<EdgePerturbationCounts>& counts)>
+      run_round;
 };
 
 // Draws perturbation j of edge `edge` (norm in (0, theta]).
@@ -63,6 +76,22 @@ PerturbationSample perturb_sample(const Simulator& sim, SimulatorWorkspace& ws,
 // Runs perturbations [counts.done, settings.perturbations) of one edge, adding to `counts`.
 void perturb_edge(const Simulator& sim, SimulatorWorkspace& ws, const Bundle& bundle, size_t edge,
                   const PerturbSettings& settings, EdgePerturbationCounts& counts);
+
+// The same from the edge's data alone (an MPI rank receives them in a message): `edge` is the
+// edge's index in the bundle, which seeds its perturbations.
+struct EdgeCommand {
+  const double* q0 = nullptr;  // dof values
+  const double* qf = nullptr;  // dof values
+  const double* knots = nullptr;
+  int knot_rows = 0;
+  double command_duration = 0;
+};
+void perturb_edge_command(const Simulator& sim, SimulatorWorkspace& ws, int dof,
+                          const EdgeCommand& command, uint64_t edge,
+                          const PerturbSettings& settings, EdgePerturbationCounts& counts);
+
+// Edge e's counts so far, as perturb_edge continues them.
+EdgePerturbationCounts counts_so_far(const Perturbation& p, size_t e);
 
 // Sets up bundle.perturbation for `settings`: keeps the existing counts when theta and seed
 // match and p does not shrink (they are extended), starts afresh when `replace` is set, and
