@@ -36,7 +36,7 @@ CommandResult tool(const std::string& name, const std::vector<std::string>& args
                    long file_limit_kib = 0, const std::string& dir = "") {
   std::string cmd = dir.empty() ? "" : "cd " + quote(dir) + " && ";
   if (file_limit_kib > 0) cmd += "ulimit -f " + std::to_string(file_limit_kib) + " && ";
-  cmd += "timeout -s KILL 120 " + quote(tool_path(name));
+  cmd += watchdog(120) + quote(tool_path(name));
   for (const std::string& a : args) cmd += " " + quote(a);
   return run(cmd);
 }
