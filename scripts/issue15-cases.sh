@@ -28,9 +28,13 @@ row() {
   fi
   local lines
   lines=$(wc -l <err.txt)
+  # More lines: the last one too (what a command lists after the tool ran).
+  if [[ ${STREAM:-err} == err && $lines -gt 1 && $(tail -n 1 err.txt) != "$text" ]]; then
+    text="$text ... $(tail -n 1 err.txt)"
+  fi
+  text=${text/%left: /left: nothing}
   text=${text//|/\\|}
-  printf '| %s | `%s` | %s | %s%s |\n' "$name" "$cmd" "$rc" "$text" \
-    "$([[ ${STREAM:-err} == err && $lines -gt 1 ]] && echo " (+$((lines - 1)) more stderr lines)")"
+  printf '| %s | `%s` | %s | %s |\n' "$name" "$cmd" "$rc" "$text"
 }
 
 # A copy of the bundled Panda in DIR with the first FROM in FILE replaced by TO.
@@ -131,12 +135,13 @@ EOF
 echo '| case | command | exit | message |'
 echo '|---|---|---|---|'
 rm -rf fs && mkdir fs
-row "full disk: build (file-size limit 100 KiB)" 'ulimit -f 100; lazyboe-build --edges 300 --out fs/out.h5 --quiet; s=$?; ls fs >&2; exit $s'
+row "full disk: build (file-size limit 100 KiB)" 'ulimit -f 100; lazyboe-build --edges 300 --out fs/out.h5 --quiet; s=$?; echo "left: $(ls fs)" >&2; exit $s'
 lazyboe-build --edges 300 --out fs/p.h5 --quiet
 lim=$(($(stat -c %s fs/p.h5) / 1024 + 1)) # the analysis does not fit
-row "full disk: perturb (limit = bundle + 1 KiB)" "ulimit -f $lim; lazyboe-perturb --bundle fs/p.h5 --perturbations 2 --quiet"
+cp fs/p.h5 p-before.h5
+row "full disk: perturb (limit = bundle + 1 KiB)" "ulimit -f $lim; lazyboe-perturb --bundle fs/p.h5 --perturbations 2 --quiet; s=\$?; cmp -s p-before.h5 fs/p.h5 && echo \"bundle unchanged; left: \$(ls fs)\" >&2; exit \$s"
 if mkdir -p tmpfs && mount -t tmpfs -o size=2m tmpfs tmpfs 2>/dev/null; then
-  row "full disk: build on a 2 MB tmpfs" 'lazyboe-build --edges 3000 --out tmpfs/out.h5 --quiet; s=$?; ls tmpfs >&2; exit $s'
+  row "full disk: build on a 2 MB tmpfs" 'lazyboe-build --edges 3000 --out tmpfs/out.h5 --quiet; s=$?; echo "left: $(ls tmpfs)" >&2; exit $s'
   umount tmpfs
 else
   echo "| full disk: build on a 2 MB tmpfs | (mount -t tmpfs refused here: no privilege) | - | not run |"
@@ -175,4 +180,4 @@ row "unwritable build output" 'lazyboe-build --edges 5 --out missing-dir/b.h5 --
 row "moved robot config" 'lazyboe-query --bundle moved.h5 --queries q.jsonl'
 row "same build twice: bytes that differ" 'lazyboe-build --edges 50 --out same1.h5 --quiet && lazyboe-build --edges 50 --out same2.h5 --quiet; echo "$(cmp -l same1.h5 same2.h5 | wc -l) bytes differ" >&2; exit 0'
 STREAM=out row "option after the subcommand" 'lazyboe-robot info --json --robot '"$src"'/data/robots/panda.json | grep -m 1 -E "^  .name.: .panda."'
-row "check stopped by SIGTERM" 'lazyboe-robot check --in big.csv --out big-r.csv & pid=$!; sleep 1.5; kill -TERM $pid; wait $pid; s=$?; ls big-r* 2>/dev/null >&2; exit $s'
+row "check stopped by SIGTERM" 'lazyboe-robot check --in big.csv --out big-r.csv & pid=$!; sleep 1.5; kill -TERM $pid; wait $pid; s=$?; echo "left: $(ls big-r* 2>/dev/null)" >&2; exit $s'
