@@ -41,8 +41,10 @@ test-sanitize: deps
 # with clang and LLVM's libomp: GCC's libgomp is not instrumented and gives false data-race
 # reports on race-free OpenMP loops; libomp with its Archer tool (loaded automatically) does not.
 TSAN_TESTS = ^(test_build_cli|test_perturb_cli|test_query_cli|test_bench_cli|Perturbation\.|RolloutPool\.|Builder\.)
-TSAN_ENV = TSAN_OPTIONS=halt_on_error=1:ignore_noninstrumented_modules=1:log_path=$(CURDIR)/$(TSAN_BUILD_DIR)/sanitizer-logs/tsan
-test-tsan: deps
+TSAN_ENV = TSAN_OPTIONS=halt_on_error=1:ignore_noninstrumented_modules=1:log_path=$(CURDIR)/$(TSAN_BUILD_DIR)/sanitizer-logs/tsan \
+  LAZYBOE_TEST_TIME_SCALE=10
+test-tsan:
+	@scripts/install-deps.sh clang libomp-dev
 	@CC=clang CXX=clang++ cmake -S . -B $(TSAN_BUILD_DIR) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DLAZYBOE_SANITIZE=thread \
 	  -DLAZYBOE_BUILD_PYTHON=OFF -DLAZYBOE_BUILD_BENCHMARKS=OFF > $(TSAN_BUILD_DIR).cmake.log 2>&1 || (cat $(TSAN_BUILD_DIR).cmake.log; exit 1)
 	@cmake --build $(TSAN_BUILD_DIR) -j$(JOBS) --target lazyboe-build lazyboe-perturb lazyboe-query lazyboe-bench \
