@@ -26,7 +26,7 @@ test: build
 # before every release. The Python module and the benchmarks are not built there (see the docs).
 ASAN_BUILD_DIR ?= build-asan
 # Wall-clock budgets and watchdogs of the tests are multiplied by this (LAZYBOE_TEST_TIME_SCALE):
-# 10 covers the sanitizers' slowdown on an idle machine; raise it on a shared, loaded one.
+# 10 is meant for an idle machine (not yet verified there); raise it on a shared, loaded one.
 TIME_SCALE ?= 10
 TSAN_BUILD_DIR ?= build-tsan
 SANITIZE_ENV = ASAN_OPTIONS=halt_on_error=1:abort_on_error=1:detect_leaks=1:fast_unwind_on_malloc=0:detect_stack_use_after_return=1:log_path=$(CURDIR)/$(ASAN_BUILD_DIR)/sanitizer-logs/asan \
