@@ -36,20 +36,23 @@ const std::string& bundle() {
   static const std::string path = [] {
     const std::string dir = fresh_dir("bench-bundle"), out = dir + "/bundle.h5";
     const CommandResult b =
-        run("timeout -s KILL 300 " + quote(tool_path("lazyboe-build")) + " --out " + quote(out) +
+        run(watchdog(300) + quote(tool_path("lazyboe-build")) + " --out " + quote(out) +
             " --edges 1500 --region=" + kRegion + " --theta 0.45 --quiet");
     if (b.exit_code != 0) throw std::runtime_error("lazyboe-build failed: " + describe(b));
-    const CommandResult p = run("timeout -s KILL 300 " + quote(tool_path("lazyboe-perturb")) +
-                                " --bundle " + quote(out) + " --perturbations 2 --quiet");
+    const CommandResult p = run(watchdog(300) + quote(tool_path("lazyboe-perturb")) + " --bundle " +
+                                quote(out) + " --perturbations 2 --quiet");
     if (p.exit_code != 0) throw std::runtime_error("lazyboe-perturb failed: " + describe(p));
     return out;
   }();
   return path;
 }
 
+// "--budget S" with S scaled by time_scale(): the sanitizers slow the planners.
+std::string budget(double seconds) { return "--budget " + std::to_string(seconds * time_scale()); }
+
 CommandResult bench(const std::string& args) {
-  return run("timeout -s KILL 300 " + quote(tool_path("lazyboe-bench")) + " --bundle " +
-             quote(bundle()) + " " + args);
+  return run(watchdog(300) + quote(tool_path("lazyboe-bench")) + " --bundle " + quote(bundle()) +
+             " " + args);
 }
 
 std::vector<std::string> lines_of(const std::string& text) {
@@ -92,7 +95,7 @@ void expect_consistent_rows(const std::vector<std::string>& rows, double budget)
     ASSERT_EQ(f.size(), 23u) << rows[k];
     EXPECT_GT(std::stoull(f[9]), 0u) << "a run that simulated nothing: " << rows[k];
     if (f[4] == "1") {
-      EXPECT_LE(std::stod(f[5]), budget + 0.5) << rows[k];
+      EXPECT_LE(std::stod(f[5]), budget + 0.5 * time_scale()) << rows[k];
       EXPECT_GT(std::stod(f[6]), 0) << rows[k];
       EXPECT_GE(std::stoi(f[7]), 1) << rows[k];
       EXPECT_LE(std::stod(f[14]), std::stod(f[17]) + 1e-3) << rows[k];  // duration <= raw
@@ -108,7 +111,8 @@ void expect_consistent_rows(const std::vector<std::string>& rows, double budget)
 
 TEST(BenchCli, TinyStudyWritesEveryFileWithConsistentRows) {
   const std::string dir = fresh_dir("study");
-  const CommandResult r = bench("--problems 2 --budget 1 --jobs 2 --seed 3 --out " + quote(dir));
+  const CommandResult r =
+      bench("--problems 2 " + budget(1) + " --jobs 2 --seed 3 --out " + quote(dir));
   ASSERT_EQ(r.exit_code, 0) << describe(r);
 
   const std::vector<std::string> problems = lines_of(read_file(dir + "/problems.jsonl"));
@@ -128,7 +132,7 @@ TEST(BenchCli, TinyStudyWritesEveryFileWithConsistentRows) {
   const std::vector<std::string> ompl = {"ompl-rrt", "ompl-sst", "ompl-kpiece"};
   const size_t planners = ours.size() + (ompl_available() ? ompl.size() : 0);
   ASSERT_EQ(rows.size(), 1 + 2 * planners) << read_file(dir + "/runs.csv");
-  expect_consistent_rows(rows, 1.0);
+  expect_consistent_rows(rows, 1.0 * time_scale());
   size_t lazy_edges = 0;
   for (size_t k = 1; k < rows.size(); ++k) {
     const std::vector<std::string> f = fields_of(rows[k]);
@@ -165,11 +169,11 @@ TEST(BenchCli, TinyStudyWritesEveryFileWithConsistentRows) {
 
   // The problems file repeats the study's problems exactly.
   const std::string again = fresh_dir("study-again");
-  const CommandResult r2 =
-      bench("--problems-file " + quote(dir + "/problems.jsonl") +
-            " --planners rrt,sst-1x --repeats 2 --budget 0.3 --no-figures --quiet --seed 3 "
-            "--out " +
-            quote(again));
+  const CommandResult r2 = bench("--problems-file " + quote(dir + "/problems.jsonl") +
+                                 " --planners rrt,sst-1x --repeats 2 " + budget(0.3) +
+                                 " --no-figures --quiet --seed 3 "
+                                 "--out " +
+                                 quote(again));
   ASSERT_EQ(r2.exit_code, 0) << describe(r2);
   EXPECT_EQ(read_file(again + "/problems.jsonl"), read_file(dir + "/problems.jsonl"));
   // 2 planners x 2 problems x 2 repeats; a (problem, repeat) has one seed for every planner,
@@ -194,7 +198,7 @@ TEST(BenchCli, TinyStudyWritesEveryFileWithConsistentRows) {
 
   // An earlier study is not overwritten without --force.
   const auto before = snapshot(dir);
-  expect_one_line_error(bench("--problems 2 --budget 1 --out " + quote(dir)),
+  expect_one_line_error(bench("--problems 2 " + budget(1) + " --out " + quote(dir)),
                         {dir, "--resume", "--force"});
   EXPECT_EQ(snapshot(dir), before);
 }
@@ -202,7 +206,7 @@ TEST(BenchCli, TinyStudyWritesEveryFileWithConsistentRows) {
 TEST(BenchCli, ResumeRunsOnlyWhatIsMissingAndIgnoresATornLine) {
   const std::string dir = fresh_dir("resume");
   const std::string args =
-      "--problems 2 --planners rrt,boe --budget 0.5 --no-figures --out " + quote(dir);
+      "--problems 2 --planners rrt,boe " + budget(0.5) + " --no-figures --out " + quote(dir);
   const CommandResult first = bench(args + " --quiet");
   ASSERT_EQ(first.exit_code, 0) << describe(first);
   const std::vector<std::string> rows = lines_of(read_file(dir + "/runs.csv"));
@@ -220,12 +224,12 @@ TEST(BenchCli, ResumeRunsOnlyWhatIsMissingAndIgnoresATornLine) {
   EXPECT_EQ(after[1], rows[1]);  // kept as saved, not run again
   EXPECT_EQ(after[3], rows[3]);
   EXPECT_EQ(fields_of(after[2])[0], fields_of(rows[2])[0]);
-  expect_consistent_rows(after, 0.5);
+  expect_consistent_rows(after, 0.5 * time_scale());
 
   // Resuming with other parameters is refused, and changes nothing.
   const auto before = snapshot(dir);
   expect_one_line_error(
-      bench("--problems 2 --planners rrt,boe --budget 2 --out " + quote(dir) + " --resume"),
+      bench("--problems 2 --planners rrt,boe " + budget(2) + " --out " + quote(dir) + " --resume"),
       {"study.json", "other parameters"});
   EXPECT_EQ(snapshot(dir), before);
 }
@@ -233,7 +237,8 @@ TEST(BenchCli, ResumeRunsOnlyWhatIsMissingAndIgnoresATornLine) {
 TEST(BenchCli, InterruptKeepsFinishedRunsForResume) {
   const std::string dir = fresh_dir("interrupt");
   const std::string command = quote(tool_path("lazyboe-bench")) + " --bundle " + quote(bundle()) +
-                              " --problems 3 --planners boe,rrt --budget 2 --no-figures --quiet "
+                              " --problems 3 --planners boe,rrt " + budget(2) +
+                              " --no-figures --quiet "
                               "--out " +
                               quote(dir);
   const pid_t pid = fork();
@@ -243,7 +248,8 @@ TEST(BenchCli, InterruptKeepsFinishedRunsForResume) {
     _exit(127);
   }
   // Wait until the first run has finished (its row is in the partial file), then interrupt.
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  const auto deadline =
+      std::chrono::steady_clock::now() + std::chrono::duration<double>(60 * time_scale());
   while (std::chrono::steady_clock::now() < deadline &&
          lines_of(fs::exists(dir + "/runs.partial.csv") ? read_file(dir + "/runs.partial.csv") : "")
                  .size() < 2) {
@@ -352,7 +358,7 @@ TEST(BenchRuns, PartialFileSurvivesATornRowAndRejectsBadFields) {
 TEST(BenchCli, ResumeOfAFinishedStudyRunsNothingAgain) {
   const std::string dir = fresh_dir("finished");
   const std::string args =
-      "--problems 2 --planners rrt --budget 0.3 --no-figures --out " + quote(dir);
+      "--problems 2 --planners rrt " + budget(0.3) + " --no-figures --out " + quote(dir);
   ASSERT_EQ(bench(args + " --quiet").exit_code, 0);
   const std::string runs = read_file(dir + "/runs.csv");
   const CommandResult again = bench(args + " --resume");
@@ -360,7 +366,7 @@ TEST(BenchCli, ResumeOfAFinishedStudyRunsNothingAgain) {
   EXPECT_TRUE(contains(again.err, "0 runs to do (2 done)")) << again.err;
   EXPECT_EQ(read_file(dir + "/runs.csv"), runs);
   expect_one_line_error(
-      bench("--problems 3 --planners rrt --budget 0.3 --out " + quote(dir) + " --resume"),
+      bench("--problems 3 --planners rrt " + budget(0.3) + " --out " + quote(dir) + " --resume"),
       {"study.json", "other parameters"});
 
   // Problem ids must be unique in a problems file.

@@ -48,8 +48,7 @@ using Clock = std::chrono::steady_clock;
 // watchdog kills a run that does not end, so a tool that misreads its input fails the test
 // instead of hanging it.
 std::string build_command(const std::vector<std::string>& args, double timeout_seconds) {
-  std::string cmd = "timeout -s KILL " + std::to_string(timeout_seconds) + " " +
-                    quote(tool_path("lazyboe-build"));
+  std::string cmd = watchdog(timeout_seconds) + quote(tool_path("lazyboe-build"));
   for (const std::string& a : args) cmd += " " + quote(a);
   return cmd;
 }
@@ -115,7 +114,7 @@ void sleep_seconds(double s) { std::this_thread::sleep_for(std::chrono::duration
 
 // Waits until `path` exists (the build's first checkpoint), the process ends, or the timeout.
 bool wait_for_file(const Background& b, const std::string& path, double timeout_seconds) {
-  const auto until = Clock::now() + std::chrono::duration<double>(timeout_seconds);
+  const auto until = Clock::now() + std::chrono::duration<double>(timeout_seconds * time_scale());
   while (Clock::now() < until) {
     if (fs::exists(path)) return true;
     int status = 0;

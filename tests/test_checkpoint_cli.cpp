@@ -32,7 +32,7 @@ constexpr int kEdges = 700;  // about a dozen checkpoints of one 64-attempt roun
 std::string command(const std::string& tool, const std::vector<std::string>& args,
                     const std::string& crash_at = "") {
   std::string cmd = crash_at.empty() ? "" : "LAZYBOE_TEST_CRASH_AT=" + quote(crash_at) + " ";
-  cmd += "timeout -s KILL " + std::to_string(120 * time_scale()) + " " + quote(tool_path(tool));
+  cmd += watchdog(120) + quote(tool_path(tool));
   for (const std::string& a : args) cmd += " " + quote(a);
   return cmd;
 }

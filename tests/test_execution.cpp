@@ -20,6 +20,7 @@
 #include "lazyboe/robot/kinematics.h"
 #include "lazyboe/sim/trajectory_check.h"
 #include "planning_fixture.h"
+#include "test_util.h"
 
 namespace lazyboe::test {
 namespace {
@@ -38,7 +39,7 @@ PlanningProblem problem_to(const JointVectorRef& start, const JointVectorRef& go
   p.start = start;
   p.goal.q = goal;
   p.goal.tolerance = kTolerance;
-  p.termination.budget = 3.0;
+  p.termination.budget = 3.0 * time_scale();  // the sanitizers slow the planners
   p.termination.stop_at_first = true;
   p.seed = 3;
   return p;

@@ -53,7 +53,7 @@ std::vector<std::string> perturb_args(const std::string& bundle) {
 // `ranks` 0: the tool alone (one process, two threads); otherwise under mpirun, one thread each.
 std::string command(int ranks, const std::string& tool, std::vector<std::string> args,
                     const std::string& env = "") {
-  std::string cmd = env + " timeout -s KILL " + std::to_string(120 * time_scale()) + " ";
+  std::string cmd = env + " " + watchdog(120);
   if (ranks > 0) {
     // As root (CI containers) mpirun needs --allow-run-as-root; two cores: --oversubscribe;
     // a container without ssh: plm_rsh_agent false (every rank is local).
@@ -188,8 +188,7 @@ TEST(Mpi, AFailureOnOneRankEndsTheJobWithOneLine) {
     return a;
   };
   const std::string cmd =
-      "cd " + quote(here) + " && timeout -s KILL " + std::to_string(60 * time_scale()) + " " +
-      quote(kMpiexec) +
+      "cd " + quote(here) + " && " + watchdog(60) + quote(kMpiexec) +
       " --allow-run-as-root --oversubscribe --bind-to none --mca plm_rsh_agent false -np 1 " +
       args(here + "/run.h5") + " : -np 1 -wdir " + quote(there) + " " + args(here + "/run.h5");
   const CommandResult r = run(cmd);

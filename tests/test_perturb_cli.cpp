@@ -62,8 +62,7 @@ using Clock = std::chrono::steady_clock;
 // watchdog that kills a run that does not end (a hang fails the test instead of stalling it).
 std::string tool_command(const std::string& tool, const std::vector<std::string>& args,
                          double timeout_seconds) {
-  std::string cmd = "timeout -s KILL " + std::to_string(timeout_seconds * time_scale()) + " " +
-                    quote(tool_path(tool));
+  std::string cmd = watchdog(timeout_seconds) + quote(tool_path(tool));
   for (const std::string& a : args) cmd += " " + quote(a);
   return cmd;
 }
@@ -144,7 +143,7 @@ ino_t inode_of(const std::string& path) {
 // `exit_code` set) or after the timeout.
 bool wait_for_checkpoint(Background& b, const std::string& path, ino_t before,
                          double timeout_seconds, int& exit_code) {
-  const auto until = Clock::now() + std::chrono::duration<double>(timeout_seconds);
+  const auto until = Clock::now() + std::chrono::duration<double>(timeout_seconds * time_scale());
   while (Clock::now() < until) {
     int status = 0;
     if (::waitpid(b.pid, &status, WNOHANG) == b.pid) {

@@ -52,14 +52,14 @@ std::string make_bundles() {
   const std::string dir = fresh_dir("bundle");
   const std::string unperturbed = dir + "/unperturbed.h5", bundle = dir + "/bundle.h5";
   const CommandResult b =
-      run("timeout -s KILL 300 " + quote(tool_path("lazyboe-build")) + " --out " +
-          quote(unperturbed) + " --edges " + std::to_string(kEdges) + " --region=" + kRegion +
-          " --theta " + std::to_string(kTheta) + " --quiet");
+      run(watchdog(300) + quote(tool_path("lazyboe-build")) + " --out " + quote(unperturbed) +
+          " --edges " + std::to_string(kEdges) + " --region=" + kRegion + " --theta " +
+          std::to_string(kTheta) + " --quiet");
   if (b.exit_code != 0) throw std::runtime_error("lazyboe-build failed: " + describe(b));
   fs::copy_file(unperturbed, bundle);
   const CommandResult p =
-      run("timeout -s KILL 300 " + quote(tool_path("lazyboe-perturb")) + " --bundle " +
-          quote(bundle) + " --perturbations " + std::to_string(kPerturbations) + " --quiet");
+      run(watchdog(300) + quote(tool_path("lazyboe-perturb")) + " --bundle " + quote(bundle) +
+          " --perturbations " + std::to_string(kPerturbations) + " --quiet");
   if (p.exit_code != 0) throw std::runtime_error("lazyboe-perturb failed: " + describe(p));
   return bundle;
 }
@@ -87,7 +87,7 @@ json query(const std::string& id, const JointVectorRef& start, const JointVector
   q["start"] = vec(start);
   q["goal"] = {{"q", vec(goal)}, {"tolerance", kTolerance}};
   q["planner"] = planner;
-  q["budget"] = budget;
+  q["budget"] = budget * time_scale();  // the sanitizers slow the planners
   q["seed"] = seed;
   if (stop_at_first) q["stop_at_first"] = true;
   return q;
@@ -100,7 +100,7 @@ std::string jsonl(const std::vector<json>& queries) {
 }
 
 std::string query_command(const std::vector<std::string>& args) {
-  std::string cmd = "timeout -s KILL 120 " + quote(tool_path("lazyboe-query"));
+  std::string cmd = watchdog(120) + quote(tool_path("lazyboe-query"));
   for (const std::string& a : args) cmd += " " + quote(a);
   return cmd;
 }

@@ -116,7 +116,7 @@ const std::vector<PlannedPath>& planned_paths() {
       p.goal.kind = Goal::Kind::Joint;
       p.goal.q = goal;
       p.goal.tolerance = kTolerance;
-      p.termination.budget = 5;
+      p.termination.budget = 5 * time_scale();  // the sanitizers slow the planners
       p.seed = 1;
       const PlanResult r = plan(context, ws, "lazysp", {}, p);
       if (!r.success) continue;

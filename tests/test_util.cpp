@@ -80,4 +80,8 @@ double time_scale() {
   return v > 0 ? v : 1.0;
 }
 
+std::string watchdog(double seconds) {
+  return "timeout -s KILL " + std::to_string(seconds * time_scale()) + " ";
+}
+
 }  // namespace lazyboe::test

@@ -30,6 +30,9 @@ std::string temp_dir();
 // LAZYBOE_TEST_TIME_SCALE (default 1), for wall-clock budgets and watchdogs: make test-sanitize
 // sets it, as the sanitizers slow everything several times over.
 double time_scale();
+// "timeout -s KILL <seconds * time_scale()> ", to prefix a tool's shell command: a run that does
+// not end is killed and fails its test instead of hanging the suite.
+std::string watchdog(double seconds);
 std::string write_temp_file(const std::string& name, const std::string& content);
 std::string read_file(const std::string& path);
 

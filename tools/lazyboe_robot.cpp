@@ -172,7 +172,8 @@ int cmd_fk(const RobotModel& robot, const std::string& q_text, const std::string
 }
 
 // SIGINT/SIGTERM stop `check` and `torques` before anything is written; the output's temporary
-// file, if any, is removed on the way out.
+// file, if any, is removed on the way out. The handlers are installed before the inputs are read,
+// so a signal during the reading (long for a big CSV) is reported the same way.
 int interrupted(const std::string& out) {
   std::fprintf(stderr, "lazyboe-robot: interrupted; %s not written\n", out.c_str());
   return 130;
@@ -184,8 +185,8 @@ int cmd_torques(const RobotModel& robot, const std::string& in, const std::strin
   for (const char* p : {"dq", "ddq"}) {
     for (const std::string& c : numbered_columns(p, n)) header.push_back(c);
   }
-  const CsvTable table = read_numeric_csv(in, header, {-1e6, 1e6});  // rad, rad/s, rad/s^2
   install_stop_handlers();
+  const CsvTable table = read_numeric_csv(in, header, {-1e6, 1e6});  // rad, rad/s, rad/s^2
   RobotData data(robot);
   CsvWriter writer(out, numbered_columns("tau", n));
   std::vector<double> row(n);
@@ -218,10 +219,10 @@ std::array<double, 4> check_row(const RobotModel& robot, const CollisionModel& c
 
 int cmd_check(const RobotModel& robot, const std::string& env_path, const std::string& in,
               const std::string& out) {
+  install_stop_handlers();
   const Environment env = load_environment(env_path);
   const CollisionModel cm = build_collision_model(robot, env);
   const CsvTable table = read_numeric_csv(in, numbered_columns("q", robot.dof), {-1e3, 1e3});
-  install_stop_handlers();
   // Rows are independent: all cores, each thread with its own workspaces (the models are
   // read-only and shared).
   const long n = static_cast<long>(table.rows.size());
