@@ -104,6 +104,22 @@ TEST(RobotModel, BranchingUrdfNeedsATipLink) {
   EXPECT_NE(message.find("tip_link"), std::string::npos) << message;
 }
 
+// Found by fuzzing (tests/fuzz/regressions/urdf/joint-loop.urdf): urdfdom accepts joints that
+// form a loop the root cannot reach; walking the chain up from the tip never ended (memory
+// grew until std::bad_alloc) and the model's links, owning each other, leaked.
+TEST(RobotModel, JointLoopIsRefusedNamingALink) {
+  std::string urdf = kArmUrdf;
+  const std::string j2 = R"(<joint name="j2" type="prismatic"><parent link="a"/>)";
+  ASSERT_NE(urdf.find(j2), std::string::npos);
+  urdf.replace(urdf.find(j2), j2.size(), R"(<joint name="j2" type="prismatic"><parent link="c"/>)");
+  test::write_temp_file("loop/arm.urdf", urdf);  // b -> c -> b, cut off from base -> a
+  for (const std::string extra : {"", R"("tip_link": "c",)"}) {
+    const std::string message = error_of(test::write_temp_file("loop/arm.json", arm_config(extra)));
+    EXPECT_NE(message.find("arm.urdf: the joints form a loop through link '"), std::string::npos)
+        << message;
+  }
+}
+
 TEST(RobotModel, MovingSideBranchIsIgnoredAndListed) {
   test::write_temp_file("arm/arm.urdf", kArmUrdf);
   const RobotModel robot =

@@ -8,8 +8,8 @@
 using namespace lazyboe;
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-  static const std::string urdf =
-      fuzz::write_scratch("panda.urdf", fuzz::read_text(fuzz::source_path("data/robots/panda.urdf")));
+  static const std::string urdf = fuzz::write_scratch(
+      "panda.urdf", fuzz::read_text(fuzz::source_path("data/robots/panda.urdf")));
   const std::string path = fuzz::write_scratch("robot.json", data, size);
   try {
     const RobotModel robot = load_robot(path);

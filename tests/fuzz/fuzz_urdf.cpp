@@ -8,8 +8,8 @@
 using namespace lazyboe;
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-  static const std::string config =
-      fuzz::write_scratch("robot.json", fuzz::read_text(fuzz::source_path("data/robots/panda.json")));
+  static const std::string config = fuzz::write_scratch(
+      "robot.json", fuzz::read_text(fuzz::source_path("data/robots/panda.json")));
   fuzz::write_scratch("panda.urdf", data, size);  // the file the config names
   try {
     const RobotModel robot = load_robot(config);

@@ -21,7 +21,8 @@ namespace {
 struct ScratchDir {
   std::string path;
   ScratchDir() {
-    const fs::path base = fs::is_directory("/dev/shm") ? fs::path("/dev/shm") : fs::temp_directory_path();
+    const fs::path base =
+        fs::is_directory("/dev/shm") ? fs::path("/dev/shm") : fs::temp_directory_path();
     std::string pattern = (base / "lazyboe-fuzz-XXXXXX").string();
     if (!::mkdtemp(pattern.data())) {
       std::perror("lazyboe fuzz: mkdtemp");

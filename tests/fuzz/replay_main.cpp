@@ -1,10 +1,10 @@
 // The ordinary build's driver for a fuzz target (ctest, no libFuzzer): runs
 // LLVMFuzzerTestOneInput on every file of the target's corpus, then on seeded mutations of them
-// for a few seconds, so that a regression on any input the fuzzer found is caught by the
-// ordinary suite. The mutations are a fixed sequence for a seed (bit flips, byte changes,
-// inserted tokens, cut and duplicated ranges, splices of two files); how far into it a run
-// gets depends on the time given.
-//   usage: fuzz_<target> CORPUS_DIR [SECONDS] [SEED]
+// for a few seconds, and on every file of the REPLAY_DIRs (the inputs of past findings, replayed
+// as they are), so that a regression on any of them is caught by the ordinary suite. The mutations
+// are a fixed sequence for a seed (bit flips, byte changes, inserted tokens, cut and duplicated
+// ranges, splices of two files); how far into it a run gets depends on the time given.
+//   usage: fuzz_<target> CORPUS_DIR [SECONDS [SEED [REPLAY_DIR...]]]
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -22,6 +22,7 @@ using Bytes = std::vector<uint8_t>;
 namespace {
 
 std::vector<Bytes> read_corpus(const std::string& dir, std::vector<std::string>& names) {
+  names.clear();
   for (const auto& entry : fs::directory_iterator(dir))
     if (entry.is_regular_file()) names.push_back(entry.path().string());
   std::sort(names.begin(), names.end());
@@ -36,9 +37,12 @@ std::vector<Bytes> read_corpus(const std::string& dir, std::vector<std::string>&
 // Tokens that parsers treat specially: numbers at the edges of ranges, JSON and CSV syntax.
 const std::vector<std::string>& tokens() {
   static const std::vector<std::string> t = {
-      "0", "-1", "1e308", "-1e308", "1e-320", "nan", "inf", "0x10", "4294967297",
-      "18446744073709551616", "9.3e9", "\"", "\\u0000", "\xff", ",", "\n", "{", "}", "[", "]",
-      ":", "null", "true", "\"\"", "<", ">", "/>", "=\"", "HDF", "\x89HDF\r\n\x1a\n"};
+      "0",     "-1",   "1e308",   "-1e308",     "1e-320",
+      "nan",   "inf",  "0x10",    "4294967297", "18446744073709551616",
+      "9.3e9", "\"",   "\\u0000", "\xff",       ",",
+      "\n",    "{",    "}",       "[",          "]",
+      ":",     "null", "true",    "\"\"",       "<",
+      ">",     "/>",   "=\"",     "HDF",        "\x89HDF\r\n\x1a\n"};
   return t;
 }
 
@@ -84,9 +88,17 @@ void mutate(Bytes& b, const std::vector<Bytes>& corpus, std::mt19937_64& rng) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc < 2 || argc > 4) {
-    std::fprintf(stderr, "usage: %s CORPUS_DIR [SECONDS] [SEED]\n", argv[0]);
+  if (argc < 2) {
+    std::fprintf(stderr, "usage: %s CORPUS_DIR [SECONDS [SEED [REPLAY_DIR...]]]\n", argv[0]);
     return 2;
+  }
+  size_t replayed = 0;
+  for (int k = 4; k < argc; ++k) {
+    std::vector<std::string> names;
+    for (const Bytes& input : read_corpus(argv[k], names)) {
+      LLVMFuzzerTestOneInput(input.data(), input.size());
+      ++replayed;
+    }
   }
   const double seconds = argc > 2 ? std::atof(argv[2]) : 2.0;
   const uint64_t seed = argc > 3 ? std::strtoull(argv[3], nullptr, 10) : 1;
@@ -110,7 +122,9 @@ int main(int argc, char** argv) {
     LLVMFuzzerTestOneInput(input.data(), input.size());
     ++mutations;
   }
-  std::printf("%zu corpus files and %ld seeded mutations (seed %llu) ran without a finding\n",
-              corpus.size(), mutations, static_cast<unsigned long long>(seed));
+  std::printf(
+      "%zu corpus files, %zu past findings and %ld seeded mutations (seed %llu) ran without a "
+      "finding\n",
+      corpus.size(), replayed, mutations, static_cast<unsigned long long>(seed));
   return 0;
 }
