@@ -202,6 +202,23 @@ TEST(Hash, Fnv1a64KnownValues) {
   EXPECT_EQ(fnv1a64_hex("foobar"), "85944171f73967e8");
 }
 
+// Jenkins' lookup3 test vectors (hashlittle), and HDF5's own checksum of a superblock.
+TEST(Hash, Lookup3KnownValues) {
+  EXPECT_EQ(lookup3("", 0, 0), 0xdeadbeefu);
+  const std::string four = "Four score and seven years ago";
+  EXPECT_EQ(lookup3(four.data(), four.size(), 0), 0x17770551u);
+  EXPECT_EQ(lookup3(four.data(), four.size(), 1), 0xcd628161u);
+  // A bundle's version 2 superblock: its last 4 bytes are the lookup3 of the 44 before them.
+  const std::string path = fresh_path("superblock");
+  write_bundle(path, random_bundle(2, 7, 3));
+  const std::string bytes = file_bytes(path);
+  ASSERT_GE(bytes.size(), 48u);
+  ASSERT_EQ(bytes[8], 2);  // superblock version
+  uint32_t stored = 0;
+  for (int i = 3; i >= 0; --i) stored = stored << 8 | static_cast<unsigned char>(bytes[44 + i]);
+  EXPECT_EQ(lookup3(bytes.data(), 44, 0), stored);
+}
+
 TEST(Hash, FilesAreLengthPrefixed) {
   const std::string a = test::write_temp_file("hash/a.txt", "ab");
   const std::string b = test::write_temp_file("hash/b.txt", "c");
