@@ -49,25 +49,6 @@ std::string loop_message(const std::string& link) {
   return "the joints form a loop through link '" + link + "' (a URDF must be a tree)";
 }
 
-// urdfdom accepts joints that form a loop the root cannot reach (each link with one parent);
-// its links own their children, so such a model would never be freed, and walking the chain
-// would never end. Refused by name, after breaking the loop.
-void refuse_joint_loops(urdf::ModelInterface& model, const std::string& path) {
-  for (const auto& [name, start] : model.links_) {
-    urdf::LinkConstSharedPtr link = start;
-    for (size_t steps = 0; link; ++steps) {
-      if (steps > model.links_.size()) {
-        for (auto& entry : model.links_) {
-          entry.second->child_links.clear();
-          entry.second->child_joints.clear();
-        }
-        fail(path, loop_message(name));
-      }
-      link = link->getParent();
-    }
-  }
-}
-
 urdf::ModelInterfaceSharedPtr parse_urdf_file(const std::string& path) {
   require_input_file(path, "URDF file");
   std::ifstream in(path);
@@ -90,7 +71,6 @@ urdf::ModelInterfaceSharedPtr parse_urdf_file(const std::string& path) {
     fail(path, "not a valid URDF" +
                    (handler.last_error.empty() ? std::string() : " (" + handler.last_error + ")"));
   }
-  refuse_joint_loops(*urdf_model, path);
   return urdf_model;
 }
 
@@ -326,8 +306,8 @@ std::vector<urdf::LinkConstSharedPtr> find_chain(const JsonField& root,
     const std::string tip_name = root.at("tip_link").string();
     urdf::LinkConstSharedPtr link = urdf_model.getLink(tip_name);
     if (!link) root.at("tip_link").fail("no link '" + tip_name + "' in " + upath);
-    // A chain longer than the URDF has links goes round a loop of joints (urdfdom does not
-    // refuse one that the root cannot reach).
+    // A chain longer than the URDF has links goes round a loop of joints (check_urdf_values
+    // refuses them before urdfdom parses the file; this bound keeps the walk finite anyway).
     while (link && link != base) {
       if (chain.size() > urdf_model.links_.size()) fail(upath, loop_message(link->name));
       chain.push_back(link);
