@@ -4,7 +4,7 @@ BUILD_DIR ?= build
 JOBS ?= $(shell nproc)
 PREFIX ?= /usr/local
 
-.PHONY: all deps build test test-sanitize test-tsan demo bench install format clean
+.PHONY: all deps build test test-sanitize test-tsan fuzz demo bench install format clean
 
 all: build
 
@@ -57,6 +57,22 @@ test-tsan:
 	cd $(TSAN_BUILD_DIR) && $(TSAN_ENV) ctest --output-on-failure -j$(JOBS) --timeout 3000 -R '$(TSAN_TESTS)'
 	@scripts/check-sanitizer-logs.sh $(TSAN_BUILD_DIR)/sanitizer-logs
 
+# libFuzzer on every parser (tests/fuzz, docs/reliability.md "Fuzzing"): configures
+# $(FUZZ_BUILD_DIR) with clang (-DLAZYBOE_FUZZ=ON: -fsanitize=fuzzer,address,undefined), builds
+# the targets and runs each, one after the other, for FUZZ_SECONDS (or FUZZ_RUNS executions,
+# whichever comes first), then prints executions, coverage and corpus per target. Any crash,
+# hang, leak or sanitizer report fails it; the inputs are in $(FUZZ_BUILD_DIR)/fuzz-artifacts.
+FUZZ_BUILD_DIR ?= build-fuzz
+FUZZ_SECONDS ?= 60
+FUZZ_RUNS ?= 0
+FUZZ_TARGETS ?=
+fuzz:
+	@scripts/install-deps.sh clang libomp-dev
+	@CC=clang CXX=clang++ cmake -S . -B $(FUZZ_BUILD_DIR) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DLAZYBOE_FUZZ=ON \
+	  -DLAZYBOE_BUILD_TESTS=OFF -DLAZYBOE_BUILD_PYTHON=OFF -DLAZYBOE_BUILD_BENCHMARKS=OFF > $(FUZZ_BUILD_DIR).cmake.log 2>&1 || (cat $(FUZZ_BUILD_DIR).cmake.log; exit 1)
+	@cmake --build $(FUZZ_BUILD_DIR) -j$(JOBS) --target fuzz_targets
+	scripts/run-fuzz.sh $(FUZZ_BUILD_DIR) $(FUZZ_SECONDS) $(FUZZ_RUNS) $(FUZZ_TARGETS)
+
 demo: build
 	@scripts/demo.sh $(BUILD_DIR)
 
@@ -70,4 +86,4 @@ format:
 	clang-format -i $$(git ls-files '*.h' '*.cpp')
 
 clean:
-	rm -rf $(BUILD_DIR) $(BUILD_DIR).cmake.log $(ASAN_BUILD_DIR) $(ASAN_BUILD_DIR).cmake.log $(TSAN_BUILD_DIR) $(TSAN_BUILD_DIR).cmake.log
+	rm -rf $(BUILD_DIR) $(BUILD_DIR).cmake.log $(FUZZ_BUILD_DIR) $(FUZZ_BUILD_DIR).cmake.log $(ASAN_BUILD_DIR) $(ASAN_BUILD_DIR).cmake.log $(TSAN_BUILD_DIR) $(TSAN_BUILD_DIR).cmake.log

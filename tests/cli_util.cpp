@@ -127,4 +127,27 @@ void expect_same_perturbation_arrays(const Perturbation& a, const Perturbation& 
                          b.p_lazy_prop_transfer));
 }
 
+::testing::AssertionResult same_bundle_but_timings(const std::string& a_path,
+                                                   const std::string& b_path, int timings) {
+  const std::string a = read_file(a_path), b = read_file(b_path);
+  if (a.size() != b.size())
+    return ::testing::AssertionFailure()
+           << a_path << ": " << a.size() << " bytes, " << b_path << ": " << b.size();
+  std::vector<std::pair<size_t, size_t>> runs;  // differing bytes closer than 8 apart: one run
+  for (size_t i = 0; i < a.size(); ++i) {
+    if (a[i] == b[i]) continue;
+    if (!runs.empty() && i - runs.back().second < 8)
+      runs.back().second = i;
+    else
+      runs.emplace_back(i, i);
+  }
+  if (runs.size() > static_cast<size_t>(2 * timings))
+    return ::testing::AssertionFailure() << runs.size() << " runs of differing bytes, more than "
+                                         << 2 * timings << "; one at byte " << runs.back().first;
+  for (const auto& [first, last] : runs)
+    if (last - first >= 8)
+      return ::testing::AssertionFailure() << "bytes differ from " << first << " to " << last;
+  return ::testing::AssertionSuccess();
+}
+
 }  // namespace lazyboe::test

@@ -28,6 +28,13 @@ std::string join(const std::vector<std::string>& v);
 // kill), nothing on stdout, and exactly one line on stderr that contains every one of `needles`.
 void expect_one_line_error(const CommandResult& r, const std::vector<std::string>& needles);
 
+// Two bundle files of the same work differ only in their `timings` wall_seconds attributes (the
+// root's, /perturbation's): each is 8 bytes plus the 4-byte checksum of the HDF5 object header
+// holding it, so at most 2 * timings runs of differing bytes, each shorter than 8 bytes
+// (schemas/bundle.md, "Same bundle, same bytes").
+::testing::AssertionResult same_bundle_but_timings(const std::string& a_path,
+                                                   const std::string& b_path, int timings);
+
 // A fresh, empty directory under the test's temp dir.
 std::string fresh_dir(const std::string& name);
 

@@ -344,7 +344,11 @@ TEST(BenchRuns, PartialFileSurvivesATornRowAndRejectsBadFields) {
            {"rrt,p0,0,42,1,0.5,1.25,1,0,,0,0,1,,,,,,,,,,", "simulations"},
            {"rrt,p9,0,42,1,0.5,1.25,1,0,7,0,0,1,,,,,,,,,,", "problem"},
            {"rrt,p0,0,42,1,0.5,1.25,1,0,7,0,0,1,,fast,,,,,,,,", "duration"},
-           {"rrt,p0,0,42,1,0.5,1.25,1,0,7,0,0,1,,1.0,-1,,,,,,,", "stops"}}) {
+           {"rrt,p0,0,42,1,0.5,1.25,1,0,7,0,0,1,,1.0,-1,,,,,,,", "stops"},
+           // Found by fuzzing: counts past the int range wrapped (4294967297 read as 1).
+           {"rrt,p0,4294967297,42,1,0.5,1.25,1,0,7,0,0,1,,,,,,,,,,", "repeat"},
+           {"rrt,p0,0,42,1,0.5,1.25,2147483648,0,7,0,0,1,,,,,,,,,,", "n_solutions"},
+           {"rrt,p0,0,42,1,0.5,1.25,1,0,7,0,0,1,,1.0,4294967296,,,,,,,", "stops"}}) {
     write_bytes(path, header + "\n" + row + "\n");
     try {
       read_runs_csv(path, ids);

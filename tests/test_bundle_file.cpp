@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <functional>
 #include <memory>
 #include <random>
@@ -199,6 +200,23 @@ TEST(Hash, Fnv1a64KnownValues) {
   EXPECT_EQ(fnv1a64_hex(""), "cbf29ce484222325");
   EXPECT_EQ(fnv1a64_hex("a"), "af63dc4c8601ec8c");
   EXPECT_EQ(fnv1a64_hex("foobar"), "85944171f73967e8");
+}
+
+// Jenkins' lookup3 test vectors (hashlittle), and HDF5's own checksum of a superblock.
+TEST(Hash, Lookup3KnownValues) {
+  EXPECT_EQ(lookup3("", 0, 0), 0xdeadbeefu);
+  const std::string four = "Four score and seven years ago";
+  EXPECT_EQ(lookup3(four.data(), four.size(), 0), 0x17770551u);
+  EXPECT_EQ(lookup3(four.data(), four.size(), 1), 0xcd628161u);
+  // A bundle's version 2 superblock: its last 4 bytes are the lookup3 of the 44 before them.
+  const std::string path = fresh_path("superblock");
+  write_bundle(path, random_bundle(2, 7, 3));
+  const std::string bytes = file_bytes(path);
+  ASSERT_GE(bytes.size(), 48u);
+  ASSERT_EQ(bytes[8], 2);  // superblock version
+  uint32_t stored = 0;
+  for (int i = 3; i >= 0; --i) stored = stored << 8 | static_cast<unsigned char>(bytes[44 + i]);
+  EXPECT_EQ(lookup3(bytes.data(), 44, 0), stored);
 }
 
 TEST(Hash, FilesAreLengthPrefixed) {
@@ -452,6 +470,53 @@ TEST(BundleFile, TruncatedFileQuietly) {
   expect_error(message, path, {"cannot open as an HDF5 file"});
   EXPECT_EQ(thread_message, message);
   EXPECT_EQ(err, "");
+}
+
+// Strings are stored in the object headers (fixed length), not in a global heap, which HDF5
+// 1.10 reads without bounds checks.
+TEST(BundleFile, StringAttributesAreFixedLength) {
+  const std::string path = fresh_path("strings");
+  write_bundle(path, random_bundle(3, 7, 5));
+  h5::File file = h5::open_file(path);
+  for (const char* name : {"tool_version", "robot_name", "rejected_reasons", "integrator"}) {
+    h5::Attribute attr(H5Aopen(file, name, H5P_DEFAULT));
+    ASSERT_TRUE(attr.valid()) << name;
+    h5::Datatype type(H5Aget_type(attr));
+    EXPECT_EQ(H5Tget_class(type), H5T_STRING) << name;
+    EXPECT_EQ(H5Tis_variable_str(type), 0) << name;
+  }
+  EXPECT_EQ(file_bytes(path).find("GCOL"), std::string::npos);  // no global heap at all
+}
+
+// A bundle input of the fuzz target (tests/fuzz/fuzz_bundle.cpp) as a file: its first byte
+// chose the reader, the rest is the file.
+std::string regression_bundle(const std::string& name) {
+  const std::string bytes =
+      file_bytes(test::source_path("tests/fuzz/regressions/bundle/" + name + ".h5"));
+  const std::string path = fresh_path(name);
+  std::ofstream(path, std::ios::binary) << bytes.substr(1);
+  return path;
+}
+
+// Bundles written with variable-length strings (before the change above) still open.
+TEST(BundleFile, OlderFileWithVariableLengthStringsOpens) {
+  const std::string path = regression_bundle("old-format-b1p");
+  const Bundle b = read_bundle(path);
+  EXPECT_EQ(b.header.robot_name, "panda");
+  EXPECT_EQ(b.size(), 1u);
+  EXPECT_EQ(BundleView::open(path).size(), 1u);
+}
+
+// Found by fuzzing (tests/fuzz/regressions/bundle/global-heap-object-past-its-collection.h5):
+// an older bundle whose global heap says an object is larger than the heap made HDF5 1.10 copy
+// far past it (a crash at the first string attribute). Now one line naming the file.
+TEST(BundleFile, DamagedGlobalHeapOfAnOlderFileIsRefused) {
+  const std::string path = regression_bundle("global-heap-object-past-its-collection");
+  for (const auto& open : std::vector<std::function<void()>>{
+           [&] { read_bundle(path); }, [&] { read_bundle_header(path); },
+           [&] { BundleView::open(path); }, [&] { BundleView::open(path, false); }}) {
+    expect_error(error_of(open), path, {"global heap", "runs past its end"});
+  }
 }
 
 TEST(BundleFile, PlainHdf5FileIsNotABundle) {

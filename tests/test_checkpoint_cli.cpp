@@ -55,26 +55,6 @@ std::vector<std::string> perturb_args(const std::string& bundle, const std::stri
 
 // The two files are the same bytes but for at most `windows` runs of up to 8 bytes (the
 // wall_seconds attributes, which time the run).
-::testing::AssertionResult same_file_but_wall_seconds(const std::string& a_path,
-                                                      const std::string& b_path, int windows) {
-  const std::string a = read_file(a_path), b = read_file(b_path);
-  if (a.size() != b.size())
-    return ::testing::AssertionFailure()
-           << a_path << ": " << a.size() << " bytes, " << b_path << ": " << b.size();
-  int found = 0;
-  for (size_t i = 0; i < a.size(); ++i) {
-    if (a[i] == b[i]) continue;
-    if (++found > windows)
-      return ::testing::AssertionFailure() << "more than " << windows << " differing 8-byte "
-                                           << "windows; another one at byte " << i;
-    size_t last = i;
-    for (size_t j = i; j < std::min(a.size(), i + 8); ++j)
-      if (a[j] != b[j]) last = j;
-    i = last;
-  }
-  return ::testing::AssertionSuccess();
-}
-
 // An uninterrupted build without any checkpoint (the reference), once per binary.
 const std::string& reference_build() {
   static const std::string path = [] {
@@ -114,13 +94,13 @@ TEST(Checkpoints, FinishedFileIsTheSameBytesWithOrWithoutCheckpoints) {
   const std::string out = dir + "/run.h5";
   const CommandResult r = tool("lazyboe-build", build_args(out, "0"));
   ASSERT_EQ(r.exit_code, 0) << describe(r);
-  EXPECT_TRUE(same_file_but_wall_seconds(out, reference_build(), 1));
+  EXPECT_TRUE(same_bundle_but_timings(out, reference_build(), 1));
   EXPECT_EQ(files_in(dir), std::vector<std::string>{"run.h5"}) << "the journal is removed";
   const std::string perturbed = dir + "/perturbed.h5";
   fs::copy_file(reference_build(), perturbed);
   const CommandResult p = tool("lazyboe-perturb", perturb_args(perturbed, "0"));
   ASSERT_EQ(p.exit_code, 0) << describe(p);
-  EXPECT_TRUE(same_file_but_wall_seconds(perturbed, reference_perturbed(), 2));
+  EXPECT_TRUE(same_bundle_but_timings(perturbed, reference_perturbed(), 2));
 }
 
 // Killed at `crash_at`: the file at --out is absent (only before the first checkpoint) or a
@@ -139,7 +119,7 @@ void crash_and_resume_build(const std::string& crash_at, bool file_expected) {
   EXPECT_EQ(inspect.exit_code, 0) << describe(inspect);
   const CommandResult resumed = tool("lazyboe-build", {"--resume", "--out", out, "--quiet"});
   ASSERT_EQ(resumed.exit_code, 0) << describe(resumed);
-  EXPECT_TRUE(same_file_but_wall_seconds(out, reference_build(), 1));
+  EXPECT_TRUE(same_bundle_but_timings(out, reference_build(), 1));
   EXPECT_FALSE(fs::exists(build_journal_path(out)));
   EXPECT_TRUE(tmp_files_in(dir).size() <= 1) << join(tmp_files_in(dir));
 }
@@ -163,7 +143,7 @@ TEST(Checkpoints, BuildKilledAtTimedMomentsResumesToTheSameBytes) {
     EXPECT_NO_THROW(read_bundle(out));
     const CommandResult resumed = tool("lazyboe-build", {"--resume", "--out", out, "--quiet"});
     ASSERT_EQ(resumed.exit_code, 0) << describe(resumed) << "\nkilled run: " << describe(r);
-    EXPECT_TRUE(same_file_but_wall_seconds(out, reference_build(), 1));
+    EXPECT_TRUE(same_bundle_but_timings(out, reference_build(), 1));
     EXPECT_FALSE(fs::exists(build_journal_path(out)));
   }
 }
@@ -206,7 +186,7 @@ TEST(Checkpoints, AJournalOfAnotherBundleIsIgnoredAndRemoved) {
   EXPECT_EQ(resumed.exit_code, 0) << describe(resumed);
   EXPECT_TRUE(contains(resumed.err, "ignored and removed")) << resumed.err;
   EXPECT_FALSE(fs::exists(build_journal_path(out)));
-  EXPECT_TRUE(same_file_but_wall_seconds(out, reference_build(), 1)) << "the file is untouched";
+  EXPECT_TRUE(same_bundle_but_timings(out, reference_build(), 1)) << "the file is untouched";
 }
 
 void crash_and_resume_perturb(const std::string& crash_at) {
@@ -220,7 +200,7 @@ void crash_and_resume_perturb(const std::string& crash_at) {
   EXPECT_NO_THROW(read_bundle(bundle));
   const CommandResult again = tool("lazyboe-perturb", perturb_args(bundle, "0"));
   ASSERT_EQ(again.exit_code, 0) << describe(again);
-  EXPECT_TRUE(same_file_but_wall_seconds(bundle, reference_perturbed(), 2));
+  EXPECT_TRUE(same_bundle_but_timings(bundle, reference_perturbed(), 2));
   EXPECT_FALSE(fs::exists(perturb_journal_path(bundle)));
 }
 
@@ -242,7 +222,7 @@ TEST(Checkpoints, PerturbKilledAtTimedMomentsResumesToTheSameBytes) {
     EXPECT_NO_THROW(read_bundle(bundle));
     const CommandResult again = tool("lazyboe-perturb", perturb_args(bundle, "0"));
     ASSERT_EQ(again.exit_code, 0) << describe(again);
-    EXPECT_TRUE(same_file_but_wall_seconds(bundle, reference_perturbed(), 2));
+    EXPECT_TRUE(same_bundle_but_timings(bundle, reference_perturbed(), 2));
   }
 }
 
@@ -259,7 +239,7 @@ TEST(Checkpoints, FullDiskInAJournalAppendKeepsEveryEarlierCheckpoint) {
   EXPECT_GE(read_journal(build_journal_path(out)).records.size(), 2u);
   const CommandResult resumed = tool("lazyboe-build", {"--resume", "--out", out, "--quiet"});
   ASSERT_EQ(resumed.exit_code, 0) << describe(resumed);
-  EXPECT_TRUE(same_file_but_wall_seconds(out, reference_build(), 1));
+  EXPECT_TRUE(same_bundle_but_timings(out, reference_build(), 1));
 }
 
 // ---- the journal itself ----

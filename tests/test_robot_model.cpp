@@ -104,6 +104,34 @@ TEST(RobotModel, BranchingUrdfNeedsATipLink) {
   EXPECT_NE(message.find("tip_link"), std::string::npos) << message;
 }
 
+// Found by fuzzing (tests/fuzz/regressions/urdf/): urdfdom accepts joints that form a loop the
+// root cannot reach, where walking the chain up from the tip never ended (memory grew until
+// std::bad_alloc); and a link that is the child of two joints, which urdfdom links into a
+// cycle that is never freed. Both are refused before urdfdom reads the file, naming the joint.
+TEST(RobotModel, JointLoopsAndLinksWithTwoParentsAreRefused) {
+  const std::string j2 = R"(<joint name="j2" type="prismatic"><parent link="a"/>)";
+  const std::string j3 = R"(<child link="c"/><origin xyz="0.1 0 0")";
+  std::string loop = kArmUrdf, two_parents = kArmUrdf, own_parent = kArmUrdf;
+  ASSERT_NE(loop.find(j2), std::string::npos);
+  ASSERT_NE(two_parents.find(j3), std::string::npos);
+  loop.replace(loop.find(j2), j2.size(), R"(<joint name="j2" type="prismatic"><parent link="c"/>)");
+  two_parents.replace(two_parents.find(j3), j3.size(), R"(<child link="a"/><origin xyz="0.1 0 0")");
+  own_parent.replace(own_parent.find(j2), j2.size(),
+                     R"(<joint name="j2" type="prismatic"><parent link="b"/>)");
+  for (const auto& [urdf, expected] : std::vector<std::pair<std::string, std::string>>{
+           {loop, "the joints form a loop through link '"},
+           {two_parents, "joint 'j3': link 'a' is already the child of joint 'j1'"},
+           {own_parent, "joint 'j2': link 'b' is its own parent"}}) {
+    test::write_temp_file("loop/arm.urdf", urdf);
+    for (const std::string extra : {"", R"("tip_link": "c",)"}) {
+      const std::string message =
+          error_of(test::write_temp_file("loop/arm.json", arm_config(extra)));
+      EXPECT_NE(message.find("arm.urdf:"), std::string::npos) << message;
+      EXPECT_NE(message.find(expected), std::string::npos) << message;
+    }
+  }
+}
+
 TEST(RobotModel, MovingSideBranchIsIgnoredAndListed) {
   test::write_temp_file("arm/arm.urdf", kArmUrdf);
   const RobotModel robot =

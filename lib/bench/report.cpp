@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <map>
 #include <sstream>
 
@@ -78,6 +79,16 @@ uint64_t parse_count(const std::string& text, const std::string& where, const st
     fail(where, column + ": expected a whole number >= 0, got '" + text + "'");
   }
   return value;
+}
+
+// The int fields of RunRecord (repeat, n_solutions, stops, ...): a larger count would wrap.
+int parse_int_count(const std::string& text, const std::string& where, const std::string& column) {
+  const uint64_t value = parse_count(text, where, column);
+  if (value > static_cast<uint64_t>(std::numeric_limits<int>::max())) {
+    fail(where, column + ": " + text + " is outside the accepted range [0, " +
+                    std::to_string(std::numeric_limits<int>::max()) + "]");
+  }
+  return static_cast<int>(value);
 }
 
 }  // namespace
@@ -171,13 +182,13 @@ std::vector<RunRecord> read_runs_csv(const std::string& path,
     const auto problem = index_of.find(fields[1]);
     if (problem == index_of.end()) fail(where, "problem: '" + fields[1] + "' is not in the study");
     r.problem = problem->second;
-    r.repeat = static_cast<int>(parse_count(fields[2], where, "repeat"));
+    r.repeat = parse_int_count(fields[2], where, "repeat");
     r.seed = parse_count(fields[3], where, "seed");
     if (fields[4] != "0" && fields[4] != "1") fail(where, "success: expected 0 or 1");
     r.success = fields[4] == "1";
     r.time_to_first_solution = parse_number(fields[5], where, "time_to_first_solution");
     r.best_cost = parse_number(fields[6], where, "best_cost");
-    r.n_solutions = static_cast<int>(parse_count(fields[7], where, "n_solutions"));
+    r.n_solutions = parse_int_count(fields[7], where, "n_solutions");
     r.counters.nodes = parse_count(fields[8], where, "nodes");
     r.counters.simulations = parse_count(fields[9], where, "simulations");
     r.counters.lazy_edges = parse_count(fields[10], where, "lazy_edges");
@@ -185,7 +196,7 @@ std::vector<RunRecord> read_runs_csv(const std::string& path,
     r.budget = parse_number(fields[12], where, "budget");
     r.failure = fields[13];
     auto count = [&](int k, const char* column) {
-      return fields[k].empty() ? -1 : static_cast<int>(parse_count(fields[k], where, column));
+      return fields[k].empty() ? -1 : parse_int_count(fields[k], where, column);
     };
     r.duration = parse_number(fields[14], where, "duration");
     r.stops = count(15, "stops");

@@ -475,7 +475,7 @@ std::string file_bytes_checksum(const std::string& path, const DatasetLocation& 
   Fnv1a64 hash;
   std::ifstream in(path, std::ios::binary);
   in.seekg(static_cast<std::streamoff>(loc.file_offset));
-  std::vector<char> buffer(1 << 20);
+  std::vector<char> buffer(static_cast<size_t>(std::min<uint64_t>(loc.bytes, 1 << 20)));
   for (uint64_t left = loc.bytes; left > 0;) {
     const size_t chunk = static_cast<size_t>(std::min<uint64_t>(left, buffer.size()));
     if (!in.read(buffer.data(), static_cast<std::streamsize>(chunk)))

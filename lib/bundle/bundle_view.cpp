@@ -7,6 +7,7 @@
 
 #include <cerrno>
 #include <cstring>
+#include <limits>
 #include <utility>
 
 #include "lazyboe/bundle/bundle_check.h"
@@ -36,12 +37,17 @@ const T* BundleView::attach(long file, const std::string& dataset,
          dataset + ": shape " + h5::shape_string(shape) + ", expected " + h5::shape_string(dims));
   }
   uint64_t count = 1;
-  for (uint64_t d : dims) count *= d;
+  for (uint64_t d : dims) {
+    if (d != 0 && count > std::numeric_limits<uint64_t>::max() / sizeof(T) / d)
+      fail(path_, dataset + ": shape " + h5::shape_string(shape) + " is too large");
+    count *= d;
+  }
   if (count == 0) return nullptr;
   if (allow_mmap && map_) {
     const DatasetLocation loc = dataset_location(path_, file, dataset);
+    const uint64_t mapped = map_.get_deleter().bytes;  // offsets from the file: no wrap-around
     if (loc.contiguous && loc.bytes == count * sizeof(T) && loc.file_offset % alignof(T) == 0 &&
-        loc.file_offset + loc.bytes <= map_.get_deleter().bytes) {
+        loc.bytes <= mapped && loc.file_offset <= mapped - loc.bytes) {
       return reinterpret_cast<const T*>(static_cast<const char*>(map_.get()) + loc.file_offset);
     }
     warnings_.push_back(

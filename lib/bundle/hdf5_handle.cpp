@@ -1,6 +1,7 @@
 #include "lazyboe/bundle/hdf5_handle.h"
 
 #include <fcntl.h>
+#include <sys/mman.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -11,6 +12,7 @@
 #include <type_traits>
 
 #include "lazyboe/common/error.h"
+#include "lazyboe/common/hash.h"
 
 namespace lazyboe::h5 {
 namespace {
@@ -48,6 +50,82 @@ Datatype vlen_string_type() {
   if (!t.valid() || H5Tset_size(t, H5T_VARIABLE) < 0 || H5Tset_cset(t, H5T_CSET_UTF8) < 0)
     fail_hdf5("", "cannot create the HDF5 string type");
   return t;
+}
+
+// Fixed-length strings of `size` bytes, padded with NULs: stored in the object header itself.
+// Variable-length strings live in a global heap, which HDF5 1.10 reads without bounds checks.
+Datatype fixed_string_type(size_t size) {
+  Datatype t(H5Tcopy(H5T_C_S1));
+  if (!t.valid() || H5Tset_size(t, std::max<size_t>(size, 1)) < 0 ||
+      H5Tset_strpad(t, H5T_STR_NULLPAD) < 0 || H5Tset_cset(t, H5T_CSET_UTF8) < 0)
+    fail_hdf5("", "cannot create the HDF5 string type");
+  return t;
+}
+
+uint64_t little_endian(const unsigned char* p, int bytes) {
+  uint64_t v = 0;
+  for (int i = bytes - 1; i >= 0; --i) v = (v << 8) | p[i];
+  return v;
+}
+
+// One global heap collection (HDF5 file format, "Global Heap"): "GCOL", version 1, 3 reserved
+// bytes, its size (8 bytes), then objects: index (2), reference count (2), reserved (4), size
+// (8), data padded to 8 bytes; index 0 is the free space, which counts its own header. False
+// when an object runs past the collection (HDF5 1.10 would copy past it) or the free space is
+// shorter than its header (HDF5 1.10 would loop forever).
+bool global_heap_fits(const unsigned char* file, uint64_t file_size, uint64_t at) {
+  const uint64_t size = little_endian(file + at + 8, 8);
+  if (size > file_size - at) return true;  // HDF5 cannot read it: a clean error, not ours
+  if (size < 16) return false;
+  const uint64_t end = at + size;
+  for (uint64_t p = at + 16; p + 16 <= end;) {
+    const uint64_t index = little_endian(file + p, 2), bytes = little_endian(file + p + 8, 8);
+    if (bytes > size) return false;
+    const uint64_t need = index == 0 ? bytes : 16 + ((bytes + 7) & ~uint64_t{7});
+    if (need < 16 || need > end - p) return false;
+    p += need;
+  }
+  return true;
+}
+
+// Variable-length strings (bundles written before fixed-length ones) are read from global heap
+// collections, which HDF5 1.10 trusts: a damaged object size is a wild memcpy. So before the
+// first such read from a file, every collection in it is checked (once per file version).
+void check_global_heaps(const std::string& where, hid_t obj) {
+  const ssize_t n = H5Fget_name(obj, nullptr, 0);
+  if (n <= 0) return;  // a file in memory (the writer's image), not read from anywhere
+  std::string path(static_cast<size_t>(n), '\0');
+  H5Fget_name(obj, path.data(), path.size() + 1);
+  const int fd = ::open(path.c_str(), O_RDONLY);
+  struct stat st;
+  if (fd < 0 || ::fstat(fd, &st) != 0) {
+    if (fd >= 0) ::close(fd);
+    fail(where, "cannot reopen the file to check its string storage: " +
+                    std::string(std::strerror(errno)));
+  }
+  static thread_local std::string checked;  // path, inode, size and time of the last file checked
+  const std::string key = path + ":" + std::to_string(st.st_ino) + ":" +
+                          std::to_string(st.st_size) + ":" + std::to_string(st.st_mtim.tv_sec) +
+                          "." + std::to_string(st.st_mtim.tv_nsec);
+  if (key == checked || st.st_size < 16) {
+    ::close(fd);
+    return;
+  }
+  const uint64_t size = static_cast<uint64_t>(st.st_size);
+  void* map = ::mmap(nullptr, size, PROT_READ, MAP_PRIVATE, fd, 0);
+  ::close(fd);
+  if (map == MAP_FAILED) fail(where, "cannot map the file to check its string storage");
+  const auto* bytes = static_cast<const unsigned char*>(map);
+  bool fits = true;
+  for (uint64_t at = 0; fits && at + 16 <= size; ++at) {
+    const void* hit = std::memchr(bytes + at, 'G', size - 16 - at + 1);
+    if (!hit) break;
+    at = static_cast<const unsigned char*>(hit) - bytes;
+    if (std::memcmp(bytes + at, "GCOL\1", 5) == 0) fits = global_heap_fits(bytes, size, at);
+  }
+  ::munmap(map, size);
+  if (!fits) fail(where, "damaged: a global heap (its variable-length strings) runs past its end");
+  checked = key;
 }
 
 std::string type_string(hid_t type) {
@@ -193,6 +271,7 @@ std::vector<std::string> read_strings(const std::string& where, hid_t obj, const
   const htri_t variable = H5Tis_variable_str(a.type);
   if (variable < 0) fail_hdf5(where, attr_where(name) + ": cannot read its string type");
   if (variable) {
+    check_global_heaps(where, obj);
     Datatype mem = vlen_string_type();
     std::vector<char*> ptrs(a.count, nullptr);
     read_attr_raw(where, name, a, mem, ptrs.data());
@@ -203,7 +282,10 @@ std::vector<std::string> read_strings(const std::string& where, hid_t obj, const
   } else {
     const size_t size = H5Tget_size(a.type);
     Datatype mem(H5Tcopy(H5T_C_S1));
-    if (!mem.valid() || H5Tset_size(mem, size) < 0 || H5Tset_strpad(mem, H5T_STR_NULLPAD) < 0)
+    // The file's character set: HDF5 converts neither way between ASCII and UTF-8.
+    const H5T_cset_t cset = H5Tget_cset(a.type);
+    if (!mem.valid() || cset < 0 || H5Tset_size(mem, size) < 0 ||
+        H5Tset_strpad(mem, H5T_STR_NULLPAD) < 0 || H5Tset_cset(mem, cset) < 0)
       fail_hdf5(where, attr_where(name) + ": cannot read its string type");
     std::vector<char> buf(size * a.count);
     read_attr_raw(where, name, a, mem, buf.data());
@@ -232,13 +314,26 @@ void quiet() {
 
 // ---- files and groups -------------------------------------------------------------------
 
+namespace {
+// The HDF5 1.8 file format (superblock 2, object header 2): every piece of metadata carries a
+// checksum that HDF5 verifies before decoding it. HDF5 1.10 decodes the older format's
+// metadata without bounds checks, so a damaged byte there could crash it (found by fuzzing).
+// Every object at an 8-byte boundary, so that datasets stay mappable as arrays of doubles (the
+// older format's headers happened to keep them there; version 2 headers are not padded).
+herr_t set_checksummed_format(hid_t fapl) {
+  if (H5Pset_alignment(fapl, 1, 8) < 0) return -1;
+  return H5Pset_libver_bounds(fapl, H5F_LIBVER_V18, H5F_LIBVER_V18);
+}
+}  // namespace
+
 File create_file(const std::string& path) {
   quiet();
   PropList fcpl = create_plist(H5P_FILE_CREATE);
   PropList fapl = create_plist(H5P_FILE_ACCESS);
   // No modification times in the root group's header: equal content gives equal files.
   // Strong close: closing the file really closes (and flushes) everything in it.
-  if (H5Pset_obj_track_times(fcpl, 0) < 0 || H5Pset_fclose_degree(fapl, H5F_CLOSE_STRONG) < 0)
+  if (H5Pset_obj_track_times(fcpl, 0) < 0 || H5Pset_fclose_degree(fapl, H5F_CLOSE_STRONG) < 0 ||
+      set_checksummed_format(fapl) < 0)
     fail_hdf5(path, "cannot set up the HDF5 file properties");
   File file(H5Fcreate(path.c_str(), H5F_ACC_TRUNC, fcpl, fapl));
   if (!file.valid()) fail_hdf5(path, "cannot create the file");
@@ -251,12 +346,28 @@ File create_memory_file(const std::string& name, uint64_t expected_bytes) {
   PropList fapl = create_plist(H5P_FILE_ACCESS);
   const size_t increment = static_cast<size_t>(std::max<uint64_t>(expected_bytes, 1 << 20));
   if (H5Pset_obj_track_times(fcpl, 0) < 0 || H5Pset_fclose_degree(fapl, H5F_CLOSE_STRONG) < 0 ||
-      H5Pset_fapl_core(fapl, increment, 0) < 0)
+      set_checksummed_format(fapl) < 0 || H5Pset_fapl_core(fapl, increment, 0) < 0)
     fail_hdf5(name, "cannot set up the HDF5 file properties");
   File file(H5Fcreate(name.c_str(), H5F_ACC_TRUNC, fcpl, fapl));
   if (!file.valid()) fail_hdf5(name, "cannot create the file in memory");
   return file;
 }
+
+namespace {
+// HDF5 1.10's H5Fget_file_image clears the superblock's "open for writing" flag in the copy but
+// leaves the checksum computed with it set, so the image of a version 2 or 3 superblock would
+// not open. The superblock: signature (8), version, offset size s, length size, flags, four
+// addresses of s bytes, then the lookup3 checksum of all that.
+void repair_superblock_checksum(std::vector<unsigned char>& image) {
+  static const unsigned char signature[8] = {0x89, 'H', 'D', 'F', '\r', '\n', 0x1a, '\n'};
+  if (image.size() < 12 || std::memcmp(image.data(), signature, 8) != 0) return;
+  if (image[8] != 2 && image[8] != 3) return;
+  const size_t covered = 12 + 4 * size_t{image[9]};
+  if (image.size() < covered + 4) return;
+  const uint32_t sum = lookup3(image.data(), covered, 0);
+  for (int i = 0; i < 4; ++i) image[covered + i] = static_cast<unsigned char>(sum >> (8 * i));
+}
+}  // namespace
 
 std::vector<unsigned char> memory_file_image(const std::string& where, File& file) {
   if (H5Fflush(file, H5F_SCOPE_GLOBAL) < 0) fail_hdf5(where, "cannot complete the file in memory");
@@ -265,6 +376,7 @@ std::vector<unsigned char> memory_file_image(const std::string& where, File& fil
   std::vector<unsigned char> image(static_cast<size_t>(size));
   if (H5Fget_file_image(file, image.data(), image.size()) != size)
     fail_hdf5(where, "cannot copy the file image out of memory");
+  repair_superblock_checksum(image);
   return image;
 }
 
@@ -439,9 +551,8 @@ void write_attr_bool(const std::string& where, hid_t obj, const std::string& nam
 void write_attr_string(const std::string& where, hid_t obj, const std::string& name,
                        const std::string& value) {
   check_no_nul(where, name, value);
-  Datatype type = vlen_string_type();
-  const char* p = value.c_str();
-  write_attr_raw(where, obj, name, type, type, {}, &p);
+  Datatype type = fixed_string_type(value.size());
+  write_attr_raw(where, obj, name, type, type, {}, value.c_str());
 }
 
 void write_attr_f64s(const std::string& where, hid_t obj, const std::string& name,
@@ -458,13 +569,16 @@ void write_attr_u64s(const std::string& where, hid_t obj, const std::string& nam
 
 void write_attr_strings(const std::string& where, hid_t obj, const std::string& name,
                         const std::vector<std::string>& values) {
-  std::vector<const char*> ptrs;
+  size_t longest = 1;
   for (const std::string& v : values) {
     check_no_nul(where, name, v);
-    ptrs.push_back(v.c_str());
+    longest = std::max(longest, v.size());
   }
-  Datatype type = vlen_string_type();
-  write_attr_raw(where, obj, name, type, type, {values.size()}, ptrs.data());
+  std::vector<char> packed(longest * values.size(), '\0');
+  for (size_t i = 0; i < values.size(); ++i)
+    std::copy(values[i].begin(), values[i].end(), packed.begin() + i * longest);
+  Datatype type = fixed_string_type(longest);
+  write_attr_raw(where, obj, name, type, type, {values.size()}, packed.data());
 }
 
 int64_t read_attr_i64(const std::string& where, hid_t obj, const std::string& name) {

@@ -139,7 +139,7 @@ void write_attr_u64(const std::string& where, hid_t obj, const std::string& name
 void write_attr_f64(const std::string& where, hid_t obj, const std::string& name, double value);
 void write_attr_bool(const std::string& where, hid_t obj, const std::string& name,
                      bool value);  // uint8 0/1
-// Variable-length UTF-8 strings (no embedded NUL).
+// Fixed-length UTF-8 strings, NUL-padded (no embedded NUL): no global heap in the file.
 void write_attr_string(const std::string& where, hid_t obj, const std::string& name,
                        const std::string& value);
 // 1-D attributes; an empty vector gives a zero-length 1-D attribute.

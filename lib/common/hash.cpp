@@ -61,4 +61,45 @@ std::string hash_files(const std::vector<std::string>& paths) {
   return h.hex();
 }
 
+namespace {
+uint32_t rotl(uint32_t x, int k) { return (x << k) | (x >> (32 - k)); }
+}  // namespace
+
+uint32_t lookup3(const void* data, size_t size, uint32_t initval) {
+  const auto* k = static_cast<const unsigned char*>(data);
+  uint32_t a, b, c;
+  a = b = c = 0xdeadbeefu + static_cast<uint32_t>(size) + initval;
+  auto word = [&](size_t i) {
+    return uint32_t{k[i]} | uint32_t{k[i + 1]} << 8 | uint32_t{k[i + 2]} << 16 |
+           uint32_t{k[i + 3]} << 24;
+  };
+  while (size > 12) {
+    a += word(0);
+    b += word(4);
+    c += word(8);
+    a -= c, a ^= rotl(c, 4), c += b;  // mix
+    b -= a, b ^= rotl(a, 6), a += c;
+    c -= b, c ^= rotl(b, 8), b += a;
+    a -= c, a ^= rotl(c, 16), c += b;
+    b -= a, b ^= rotl(a, 19), a += c;
+    c -= b, c ^= rotl(b, 4), b += a;
+    size -= 12;
+    k += 12;
+  }
+  if (size == 0) return c;
+  uint32_t tail[3] = {0, 0, 0};  // the last 1..12 bytes, little-endian, zero-padded
+  for (size_t i = 0; i < size; ++i) tail[i / 4] |= uint32_t{k[i]} << (8 * (i % 4));
+  a += tail[0];
+  b += tail[1];
+  c += tail[2];
+  c ^= b, c -= rotl(b, 14);  // final
+  a ^= c, a -= rotl(c, 11);
+  b ^= a, b -= rotl(a, 25);
+  c ^= b, c -= rotl(b, 16);
+  a ^= c, a -= rotl(c, 4);
+  b ^= a, b -= rotl(a, 14);
+  c ^= b, c -= rotl(b, 24);
+  return c;
+}
+
 }  // namespace lazyboe

@@ -30,4 +30,8 @@ std::string fnv1a64_hex(const std::string& bytes);
 // An unreadable file throws Error naming it.
 std::string hash_files(const std::vector<std::string>& paths);
 
+// Bob Jenkins' lookup3 hash ("hashlittle", byte by byte), the checksum HDF5 puts on its
+// metadata (written here from the published algorithm, for hdf5_handle's superblock repair).
+uint32_t lookup3(const void* data, size_t size, uint32_t initval);
+
 }  // namespace lazyboe

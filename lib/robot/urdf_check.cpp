@@ -3,6 +3,7 @@
 #include <tinyxml.h>
 
 #include <cstring>
+#include <map>
 #include <sstream>
 #include <vector>
 
@@ -130,6 +131,45 @@ void walk(const std::string& path, const TiXmlElement* e) {
   }
 }
 
+// The joints must make a tree: each link the child of at most one joint, and no loop. urdfdom
+// checks neither: a link with two parents or a loop of joints is linked into a cycle of owning
+// pointers (never freed, even when urdfdom then fails for want of a single root), and walking
+// up a loop never ends (found by fuzzing).
+void check_tree(const std::string& path, const TiXmlElement* robot) {
+  struct ParentJoint {
+    std::string parent;
+    const TiXmlElement* joint;
+  };
+  std::map<std::string, ParentJoint> parent_of;  // child link -> its joint
+  for (const TiXmlElement* j = robot->FirstChildElement("joint"); j;
+       j = j->NextSiblingElement("joint")) {
+    const TiXmlElement* p = j->FirstChildElement("parent");
+    const TiXmlElement* c = j->FirstChildElement("child");
+    const char* parent = p ? p->Attribute("link") : nullptr;
+    const char* child = c ? c->Attribute("link") : nullptr;
+    if (!parent || !child) continue;  // urdfdom reports it
+    if (std::strcmp(parent, child) == 0)
+      fail(where_of(path, j), "link '" + std::string(child) + "' is its own parent");
+    const auto [it, added] = parent_of.emplace(child, ParentJoint{parent, j});
+    if (!added) {
+      const char* other = it->second.joint->Attribute("name");
+      fail(where_of(path, j), "link '" + std::string(child) + "' is already the child of joint '" +
+                                  (other ? other : "?") + "' (a URDF must be a tree)");
+    }
+  }
+  for (const auto& [start, first] : parent_of) {
+    std::string link = start;
+    for (size_t steps = 0;; ++steps) {
+      const auto up = parent_of.find(link);
+      if (up == parent_of.end()) break;
+      if (steps > parent_of.size())
+        fail(where_of(path, first.joint),
+             "the joints form a loop through link '" + start + "' (a URDF must be a tree)");
+      link = up->second.parent;
+    }
+  }
+}
+
 }  // namespace
 
 void check_urdf_values(const std::string& xml_text, const std::string& path) {
@@ -137,6 +177,7 @@ void check_urdf_values(const std::string& xml_text, const std::string& path) {
   xml.Parse(xml_text.c_str());
   if (xml.Error() || !xml.RootElement()) return;  // reported by the caller
   walk(path, xml.RootElement());
+  check_tree(path, xml.RootElement());
 }
 
 }  // namespace lazyboe
