@@ -20,16 +20,35 @@
 
 namespace lazyboe::mpi {
 
-// What every rank needs to compute attempts: the inputs (paths as rank 0 resolved them, and
-// their content hashes) and the settings.
-inline std::string build_job(const std::string& robot_path, const std::string& env_path,
-                             const BundleHeader& h, const BuildSettings& s) {
-  std::string out;
-  ByteWriter w(out);
+// The inputs every rank loads, as rank 0 resolved their paths, with their content hashes (a rank
+// that reads other content refuses to compute).
+struct SceneInputs {
+  std::string robot_path, env_path, robot_hash, env_hash;
+};
+
+inline void put_scene_inputs(ByteWriter& w, const std::string& robot_path,
+                             const std::string& env_path, const BundleHeader& h) {
   w.put_string(robot_path);
   w.put_string(env_path);
   w.put_string(h.robot_hash);
   w.put_string(h.env_hash);
+}
+
+inline SceneInputs get_scene_inputs(ByteReader& r) {
+  SceneInputs in;
+  in.robot_path = r.get_string();
+  in.env_path = r.get_string();
+  in.robot_hash = r.get_string();
+  in.env_hash = r.get_string();
+  return in;
+}
+
+// What every rank needs to compute attempts: the inputs and the settings.
+inline std::string build_job(const std::string& robot_path, const std::string& env_path,
+                             const BundleHeader& h, const BuildSettings& s) {
+  std::string out;
+  ByteWriter w(out);
+  put_scene_inputs(w, robot_path, env_path, h);
   w.put(s.edges);
   w.put(s.seed);
   w.put_array(s.region_lower.data(), s.region_lower.size());
@@ -48,16 +67,15 @@ struct RankScene {
   std::unique_ptr<Simulator> sim;
 };
 
-inline void load_rank_scene(RankScene& scene, const std::string& robot_path,
-                            const std::string& env_path, const std::string& robot_hash,
-                            const std::string& env_hash, const SimulationOptions& options) {
-  scene.robot = load_robot(robot_path);
-  if (robot_identity(scene.robot) != robot_hash)
-    fail(robot_path, "differs on this rank from rank 0's robot (content hash " +
-                         robot_identity(scene.robot) + ", rank 0: " + robot_hash + ")");
-  scene.env = load_environment(env_path);
-  if (environment_identity(scene.env) != env_hash)
-    fail(env_path, "differs on this rank from rank 0's environment");
+inline void load_rank_scene(RankScene& scene, const SceneInputs& in,
+                            const SimulationOptions& options) {
+  scene.robot = load_robot(in.robot_path);
+  if (robot_identity(scene.robot) != in.robot_hash)
+    fail(in.robot_path, "differs on this rank from rank 0's robot (content hash " +
+                            robot_identity(scene.robot) + ", rank 0: " + in.robot_hash + ")");
+  scene.env = load_environment(in.env_path);
+  if (environment_identity(scene.env) != in.env_hash)
+    fail(in.env_path, "differs on this rank from rank 0's environment");
   scene.collision = std::make_unique<CollisionModel>(build_collision_model(scene.robot, scene.env));
   scene.sim = std::make_unique<Simulator>(scene.robot, *scene.collision, options);
 }
@@ -121,8 +139,7 @@ inline void serve_build(int threads) {
   broadcast(job);
   if (job.empty()) return;
   ByteReader r(job.data(), job.size(), "job");
-  const std::string robot_path = r.get_string(), env_path = r.get_string();
-  const std::string robot_hash = r.get_string(), env_hash = r.get_string();
+  const SceneInputs inputs = get_scene_inputs(r);
   BuildSettings s;
   s.edges = r.get<uint64_t>();
   s.seed = r.get<uint64_t>();
@@ -133,7 +150,7 @@ inline void serve_build(int threads) {
   s.simulation = r.get<SimulationOptions>();
   s.design_theta = r.get<double>();
   RankScene scene;
-  load_rank_scene(scene, robot_path, env_path, robot_hash, env_hash, s.simulation);
+  load_rank_scene(scene, inputs, s.simulation);
   AttemptGenerator generator(*scene.sim, s, threads);
   std::vector<EdgeAttempt> mine;
   std::string bytes;

@@ -23,10 +23,7 @@ inline std::string perturb_job(const BundleScene& scene, const BundleHeader& h,
                                const PerturbSettings& s, const SimulationOptions& options) {
   std::string out;
   ByteWriter w(out);
-  w.put_string(scene.robot.config_path);
-  w.put_string(scene.env.path);
-  w.put_string(h.robot_hash);
-  w.put_string(h.env_hash);
+  put_scene_inputs(w, scene.robot.config_path, scene.env.path, h);
   w.put(s);
   w.put(options);
   w.put<int64_t>(h.dof);
@@ -121,13 +118,12 @@ inline void serve_perturb(int threads) {
   broadcast(job);
   if (job.empty()) return;
   ByteReader r(job.data(), job.size(), "job");
-  const std::string robot_path = r.get_string(), env_path = r.get_string();
-  const std::string robot_hash = r.get_string(), env_hash = r.get_string();
+  const SceneInputs inputs = get_scene_inputs(r);
   const PerturbSettings s = r.get<PerturbSettings>();
   const SimulationOptions options = r.get<SimulationOptions>();
   const int dof = static_cast<int>(r.get<int64_t>());
   RankScene scene;
-  load_rank_scene(scene, robot_path, env_path, robot_hash, env_hash, options);
+  load_rank_scene(scene, inputs, options);
   const int nthreads = threads > 0 ? threads : omp_get_max_threads();
   std::vector<SimulatorWorkspace> workspaces;
   for (int t = 0; t < nthreads; ++t) workspaces.emplace_back(*scene.sim);

@@ -53,13 +53,23 @@ struct EdgeInputs {
   CommandProfile profile;
 };
 
-EdgeInputs edge_inputs(const Bundle& b, size_t e) {
+// An edge's command as pointers into the bundle (or into a rank's copy of it, MPI).
+EdgeCommand edge_command(const Bundle& b, size_t e) {
   const int n = b.dof();
-  return EdgeInputs{Eigen::Map<const Eigen::VectorXd>(&b.q0[e * n], n),
-                    Eigen::Map<const Eigen::VectorXd>(&b.qf[e * n], n),
-                    CommandProfile{&b.knots[b.knot_offset[e] * n],
-                                   static_cast<int>(b.knot_offset[e + 1] - b.knot_offset[e]), n,
-                                   b.command_duration[e]}};
+  EdgeCommand command;
+  command.q0 = &b.q0[e * n];
+  command.qf = &b.qf[e * n];
+  command.knots = &b.knots[b.knot_offset[e] * n];
+  command.knot_rows = static_cast<int>(b.knot_offset[e + 1] - b.knot_offset[e]);
+  command.command_duration = b.command_duration[e];
+  return command;
+}
+
+EdgeInputs edge_inputs(const EdgeCommand& command, int dof) {
+  return EdgeInputs{
+      Eigen::Map<const Eigen::VectorXd>(command.q0, dof),
+      Eigen::Map<const Eigen::VectorXd>(command.qf, dof),
+      CommandProfile{command.knots, command.knot_rows, dof, command.command_duration}};
 }
 
 // Perturbation j of an edge: the rollout from q0 + d and both residuals of its end.
@@ -83,19 +93,12 @@ PerturbationSample sample(const Simulator& sim, SimulatorWorkspace& ws, const Ed
 
 PerturbationSample perturb_sample(const Simulator& sim, SimulatorWorkspace& ws, const Bundle& b,
                                   size_t e, const PerturbSettings& s, uint64_t j) {
-  return sample(sim, ws, edge_inputs(b, e), s, b.dof(), e, j, nullptr);
+  return sample(sim, ws, edge_inputs(edge_command(b, e), b.dof()), s, b.dof(), e, j, nullptr);
 }
 
 void perturb_edge(const Simulator& sim, SimulatorWorkspace& ws, const Bundle& b, size_t e,
                   const PerturbSettings& s, EdgePerturbationCounts& c) {
-  const int n = b.dof();
-  EdgeCommand command;
-  command.q0 = &b.q0[e * n];
-  command.qf = &b.qf[e * n];
-  command.knots = &b.knots[b.knot_offset[e] * n];
-  command.knot_rows = static_cast<int>(b.knot_offset[e + 1] - b.knot_offset[e]);
-  command.command_duration = b.command_duration[e];
-  perturb_edge_command(sim, ws, n, command, e, s, c);
+  perturb_edge_command(sim, ws, b.dof(), edge_command(b, e), e, s, c);
 }
 
 EdgePerturbationCounts counts_so_far(const Perturbation& p, size_t e) {
@@ -114,10 +117,7 @@ EdgePerturbationCounts counts_so_far(const Perturbation& p, size_t e) {
 void perturb_edge_command(const Simulator& sim, SimulatorWorkspace& ws, int dof,
                           const EdgeCommand& command, uint64_t e, const PerturbSettings& s,
                           EdgePerturbationCounts& c) {
-  const EdgeInputs in{
-      Eigen::Map<const Eigen::VectorXd>(command.q0, dof),
-      Eigen::Map<const Eigen::VectorXd>(command.qf, dof),
-      CommandProfile{command.knots, command.knot_rows, dof, command.command_duration}};
+  const EdgeInputs in = edge_inputs(command, dof);
   for (uint64_t j = c.done; j < s.perturbations; ++j) {
     const PerturbationSample r = sample(sim, ws, in, s, dof, e, j, &c.simulated_seconds);
     ++c.done;
