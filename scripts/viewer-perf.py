@@ -66,9 +66,9 @@ def tree_cpu_seconds(root):
     return total
 
 
-def measure(binary, page, width, height, seconds):
+def measure(binary, page, width, height, seconds, query):
     with chromium.Chromium(binary, width, height) as browser:
-        browser.open(page)
+        browser.open(page, query)
         if not browser.wait_for("document.body.dataset.status === 'ready'", 60):
             raise RuntimeError("page not ready: " + str(browser.console_errors))
         state = json.loads(browser.evaluate("JSON.stringify(Object.assign({}, document.body.dataset))"))
@@ -96,6 +96,7 @@ def main():
     p.add_argument("--runs", type=int, default=3)
     p.add_argument("--seconds", type=float, default=5)
     p.add_argument("--size", default="1280x800")
+    p.add_argument("--query", default="", help='URL query of the page, e.g. "scale=0.5"')
     a = p.parse_args()
     binary = chromium.find_chromium()
     if not binary:
@@ -106,7 +107,7 @@ def main():
     runs = []
     for _ in range(a.runs):
         load = os.getloadavg()[0]
-        s = measure(binary, page, width, height, a.seconds)
+        s = measure(binary, page, width, height, a.seconds, a.query)
         s["load_average"] = load
         runs.append(s)
         print(f"load {s['load_ms']:.0f} ms, {s['fps']:.1f} fps (mean frame interval "

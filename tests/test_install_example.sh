@@ -20,8 +20,10 @@ region="-0.3:0.3,0.0:0.5,-0.3:0.3,-2.3:-1.7,-0.3:0.3,1.6:2.2,0.5:1.1"
 "$bin/lazyboe-perturb" --bundle "$work/b.h5" --perturbations 2 --quiet
 start=0,0.25,0,-2,0,1.9,0.8
 goal=0.2,0.1,0.15,-1.85,-0.15,2.0,0.9
+# The planning budget scales with LAZYBOE_TEST_TIME_SCALE (sanitizer builds are ~10x slower).
+budget=$(awk -v s="${LAZYBOE_TEST_TIME_SCALE:-1}" 'BEGIN { print 5 * s }')
 for planner in lazyboe boe rrt; do
-  out=$("$work/example/plan_one_query" "$work/b.h5" "$start" "$goal" "$planner")
+  out=$("$work/example/plan_one_query" "$work/b.h5" "$start" "$goal" "$planner" 0.3 "$budget")
   echo "$out"
   case "$out" in "$planner: solved in "*) ;; *) echo "FAIL: $planner did not solve"; exit 1 ;; esac
 done
@@ -30,3 +32,7 @@ if "$work/example/plan_one_query" "$work/b.h5" "$start" "9,9,9,9,9,9,9" 2> "$wor
   echo "FAIL: a goal outside the limits was accepted"; exit 1
 fi
 grep -q "goal.q: outside the joint limits" "$work/err" || { cat "$work/err"; exit 1; }
+if "$work/example/plan_one_query" "$work/b.h5" "$start" "$goal" rrt 0.3 abc 2> "$work/err"; then
+  echo "FAIL: a budget that is not a number was accepted"; exit 1
+fi
+grep -q "are numbers" "$work/err" || { cat "$work/err"; exit 1; }

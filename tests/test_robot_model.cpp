@@ -107,7 +107,9 @@ TEST(RobotModel, BranchingUrdfNeedsATipLink) {
 // Found by fuzzing (tests/fuzz/regressions/urdf/): urdfdom accepts joints that form a loop the
 // root cannot reach, where walking the chain up from the tip never ended (memory grew until
 // std::bad_alloc); and a link that is the child of two joints, which urdfdom links into a
-// cycle that is never freed. Both are refused before urdfdom reads the file, naming the joint.
+// cycle that is never freed. Both are refused before urdfdom reads the file, naming the joint,
+// also when another element comes before <robot> (urdfdom reads the first <robot>, not the
+// document's first element: that input leaked too).
 TEST(RobotModel, JointLoopsAndLinksWithTwoParentsAreRefused) {
   const std::string j2 = R"(<joint name="j2" type="prismatic"><parent link="a"/>)";
   const std::string j3 = R"(<child link="c"/><origin xyz="0.1 0 0")";
@@ -118,10 +120,14 @@ TEST(RobotModel, JointLoopsAndLinksWithTwoParentsAreRefused) {
   two_parents.replace(two_parents.find(j3), j3.size(), R"(<child link="a"/><origin xyz="0.1 0 0")");
   own_parent.replace(own_parent.find(j2), j2.size(),
                      R"(<joint name="j2" type="prismatic"><parent link="b"/>)");
+  std::string after_a_stray_element = own_parent;
+  ASSERT_NE(after_a_stray_element.find("<robot"), std::string::npos);
+  after_a_stray_element.insert(after_a_stray_element.find("<robot"), "<collision/>\n");
   for (const auto& [urdf, expected] : std::vector<std::pair<std::string, std::string>>{
            {loop, "the joints form a loop through link '"},
            {two_parents, "joint 'j3': link 'a' is already the child of joint 'j1'"},
-           {own_parent, "joint 'j2': link 'b' is its own parent"}}) {
+           {own_parent, "joint 'j2': link 'b' is its own parent"},
+           {after_a_stray_element, "joint 'j2': link 'b' is its own parent"}}) {
     test::write_temp_file("loop/arm.urdf", urdf);
     for (const std::string extra : {"", R"("tip_link": "c",)"}) {
       const std::string message =

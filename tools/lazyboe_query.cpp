@@ -203,10 +203,11 @@ std::vector<Outcome> answer_file(const Job& job, const std::string& path, std::o
 #pragma omp parallel for num_threads(jobs) schedule(dynamic, 1) ordered
   for (long k = 0; k < static_cast<long>(lines.size()); ++k) {
     const int t = omp_get_thread_num();
-    auto [json, o] = answer(job, lines[k].second, lines[k].first, workspaces[t], *pools[t]);
-    outcomes[k] = o;
+    // Not a structured binding: clang cannot use one inside the ordered region.
+    const auto answered = answer(job, lines[k].second, lines[k].first, workspaces[t], *pools[t]);
+    outcomes[k] = answered.second;
 #pragma omp ordered
-    { out << json << "\n" << std::flush; }
+    { out << answered.first << "\n" << std::flush; }
   }
   return outcomes;
 }

@@ -58,6 +58,10 @@
   }
 
   // ---- Scene ----------------------------------------------------------------------------
+  // three.js layer of what moves during playback (the played robot); everything else is on
+  // layer 0 and is still between user actions. The translucent still objects are also on the
+  // overlay layer (section "Still layers").
+  const MOVING_LAYER = 1, OVERLAY_LAYER = 2;
   // A software rasteriser (SwiftShader in headless Chromium, llvmpipe) draws without
   // antialiasing: multisampling on the CPU costs most of the frame.
   function webglRenderer() {
@@ -74,7 +78,13 @@
   const software = /swiftshader|llvmpipe|software/i.test(rendererName);
   const view = $('view');
   const renderer = new THREE.WebGLRenderer({antialias: !software});
-  renderer.setPixelRatio(window.devicePixelRatio || 1);
+  // Options in the page's URL (view.html?scale=0.5&cache=0): `scale`, pixels drawn per CSS
+  // pixel (0.25 to 1; default 1); `cache`, whether the still layers are drawn once and reused
+  // (section "Still layers" below; default: on for a software renderer, off with a GPU).
+  const options = new URLSearchParams(window.location.search);
+  const scaleOption = Number(options.get('scale'));
+  const renderScale = scaleOption >= 0.25 && scaleOption <= 1 ? scaleOption : 1;
+  renderer.setPixelRatio((window.devicePixelRatio || 1) * renderScale);
   view.appendChild(renderer.domElement);
   const scene = new THREE.Scene();
   scene.background = new THREE.Color(0xf2f3f5);
@@ -84,10 +94,14 @@
   const controls = new THREE.OrbitControls(camera, renderer.domElement);
   controls.target.set(0.35, 0, 0.35);
   controls.update();
-  scene.add(new THREE.HemisphereLight(0xffffff, 0x8890a0, 0.75));
+  const sky = new THREE.HemisphereLight(0xffffff, 0x8890a0, 0.75);
   const sun = new THREE.DirectionalLight(0xffffff, 0.55);
   sun.position.set(2, -1, 3);
-  scene.add(sun);
+  for (const light of [sky, sun]) {
+    light.layers.enable(MOVING_LAYER);  // lights every layer
+    light.layers.enable(OVERLAY_LAYER);
+    scene.add(light);
+  }
   const grid = new THREE.GridHelper(2, 20, 0xb0b4bc, 0xd4d7dc);
   grid.rotation.x = Math.PI / 2;
   scene.add(grid);
@@ -97,7 +111,10 @@
     renderer.setSize(w, h);
     camera.aspect = w / Math.max(1, h);
     camera.updateProjectionMatrix();
+    stillLayers.resize();
   }
+  const stillLayers = makeStillLayers();
+  controls.addEventListener('change', stillLayers.changed);
   window.addEventListener('resize', resize);
   resize();
 
@@ -107,6 +124,84 @@
     object.matrix.set(R[0], R[1], R[2], p[0], R[3], R[4], R[5], p[1], R[6], R[7], R[8], p[2], 0, 0, 0, 1);
     object.matrixWorldNeedsUpdate = true;
   }
+  // ---- Still layers ---------------------------------------------------------------------
+  // A software rasteriser spends most of a frame drawing the bundle's points, the paths and the
+  // obstacles again although only the played robot moves. With the cache, layer 0 is drawn
+  // into a colour and depth texture when something on it changes (the camera, a selection, the
+  // colouring, the window's size); each frame copies both back (one full-screen triangle pair
+  // writing colour and depth) and draws the moving layer over them, depth-tested, so the robot
+  // still passes behind obstacles. The robot marks its pixels in the stencil buffer, and the
+  // translucent still objects (ghosts, faint paths, the goal region) are drawn again on those
+  // pixels only: where one is in front of the robot it is blended over it, as without the cache,
+  // and nowhere is it blended twice.
+  function makeStillLayers() {
+    const wanted = options.has('cache') ? options.get('cache') !== '0' : software;
+    const canCache = renderer.extensions.get('WEBGL_depth_texture') && renderer.extensions.get('EXT_frag_depth');
+    if (!wanted || !canCache) {
+      camera.layers.enable(MOVING_LAYER);
+      return {cached: false, changed() {}, resize() {}, render() { renderer.render(scene, camera); }};
+    }
+    const target = new THREE.WebGLRenderTarget(1, 1, {minFilter: THREE.NearestFilter, magFilter: THREE.NearestFilter,
+                                                      depthBuffer: true, stencilBuffer: false});
+    target.depthTexture = new THREE.DepthTexture();
+    target.depthTexture.type = THREE.UnsignedIntType;
+    const copy = new THREE.Mesh(new THREE.PlaneBufferGeometry(2, 2), new THREE.ShaderMaterial({
+      uniforms: {colour: {value: target.texture}, depth: {value: target.depthTexture}},
+      vertexShader: 'varying vec2 uv0; void main() { uv0 = uv; gl_Position = vec4(position.xy, 0.0, 1.0); }',
+      fragmentShader: 'uniform sampler2D colour; uniform sampler2D depth; varying vec2 uv0;\n' +
+        'void main() { gl_FragColor = texture2D(colour, uv0); gl_FragDepthEXT = texture2D(depth, uv0).x; }',
+      extensions: {fragDepth: true}, depthTest: true, depthFunc: THREE.AlwaysDepth, depthWrite: true}));
+    copy.frustumCulled = false;
+    const copyScene = new THREE.Scene();
+    copyScene.add(copy);
+    const copyCamera = new THREE.OrthographicCamera(-1, 1, 1, -1, 0, 1);
+    let dirty = true, prepared = false;
+    function prepare() {  // the scene is complete at the first frame
+      scene.traverse((o) => {
+        if (!o.material) return;
+        if (o.layers.test(camera.layers) && o.material.transparent) {
+          o.layers.enable(OVERLAY_LAYER);
+          Object.assign(o.material, {stencilWrite: true, stencilFunc: THREE.EqualStencilFunc, stencilRef: 1,
+                                     stencilZPass: THREE.KeepStencilOp});
+        } else if ((o.layers.mask & (1 << MOVING_LAYER)) !== 0) {
+          Object.assign(o.material, {stencilWrite: true, stencilFunc: THREE.AlwaysStencilFunc, stencilRef: 1,
+                                     stencilZPass: THREE.ReplaceStencilOp});
+        }
+      });
+      prepared = true;
+    }
+    return {
+      cached: true,
+      changed() { dirty = true; },
+      resize() {
+        const size = renderer.getDrawingBufferSize(new THREE.Vector2());
+        target.setSize(size.x, size.y);
+        dirty = true;
+      },
+      render() {
+        camera.layers.set(0);
+        if (!prepared) prepare();
+        if (dirty) {
+          renderer.setRenderTarget(target);
+          renderer.render(scene, camera);
+          renderer.setRenderTarget(null);
+          dirty = false;
+        }
+        renderer.render(copyScene, copyCamera);
+        // Over the copy: no clearing, not even by the scene's background colour.
+        const background = scene.background;
+        scene.background = null;
+        renderer.autoClear = false;
+        camera.layers.set(MOVING_LAYER);
+        renderer.render(scene, camera);
+        camera.layers.set(OVERLAY_LAYER);
+        renderer.render(scene, camera);
+        renderer.autoClear = true;
+        scene.background = background;
+      },
+    };
+  }
+
   // A shape of lib/robot/robot_model.h; cylinders and capsules along their local z.
   function shapeObject(s, material) {
     const along = (g) => g.rotateX(Math.PI / 2);
@@ -128,7 +223,7 @@
   const robot = data.robot;
   const robotLayer = new THREE.Group();  // the robot and its ghosts
   scene.add(robotLayer);
-  function makeRobot(colour, opacity) {
+  function makeRobot(colour, opacity, layer) {
     // A ghost's surfaces are pushed back in depth, so where it coincides with the robot (at the
     // start, at the goal) the robot is drawn, not a flicker of both.
     const ghost = opacity < 1;
@@ -136,19 +231,25 @@
                                                     depthWrite: !ghost, polygonOffset: ghost,
                                                     polygonOffsetFactor: 2, polygonOffsetUnits: 2});
     const group = new THREE.Group();
-    const parts = robot.shapes.map((s) => { const o = shapeObject(s, material); group.add(o); return o; });
+    const parts = robot.shapes.map((s) => {
+      const o = shapeObject(s, material);
+      o.layers.set(layer);
+      group.add(o);
+      return o;
+    });
     robotLayer.add(group);
     return {
       group: group,
       setQ(q) {
+        if (layer !== MOVING_LAYER) stillLayers.changed();
         const poses = linkPoses(robot, q);
         robot.shapes.forEach((s, i) => setMatrix(parts[i], compose(poses[s.link], s.pose)));
       },
     };
   }
-  const mainRobot = makeRobot(0xe09040, 1);
-  const startGhost = makeRobot(0x30a050, 0.3);
-  const goalGhost = makeRobot(0xc03030, 0.3);
+  const mainRobot = makeRobot(0xe09040, 1, MOVING_LAYER);
+  const startGhost = makeRobot(0x30a050, 0.3, 0);
+  const goalGhost = makeRobot(0xc03030, 0.3, 0);
   const goalRegion = new THREE.Mesh(new THREE.SphereBufferGeometry(1, 24, 16),
                                     new THREE.MeshLambertMaterial({color: 0xc03030, transparent: true, opacity: 0.3}));
   scene.add(goalRegion);
@@ -268,6 +369,7 @@
     $('timeline').value = duration() > 0 ? String(Math.round(1000 * play.time / duration())) : '0';
   }
   function select(kind, i) {
+    stillLayers.changed();
     for (const x of trajectories.concat(failures)) x.row.classList.remove('selected');
     if (kind === 'trajectory') {
       const tr = trajectories[i];
@@ -322,6 +424,7 @@
     density: {label: 'neighbours within theta', low: 0, high: null, reversed: false},
   };
   function colourBundle(field) {
+    stillLayers.changed();
     const values = bundle[field], ramp = ramps[field];
     const high = ramp.high === null ? Math.max(1, ...values) : ramp.high;
     const colours = bundlePoints.geometry.attributes.color;
@@ -389,7 +492,7 @@
     }
     frames.last = now;
     const t0 = performance.now();
-    renderer.render(scene, camera);
+    stillLayers.render();
     frames.renderMs.push(performance.now() - t0);
     if (frames.renderMs.length > 600) frames.renderMs.shift();
     if (++frames.count % 30 === 0) $('fps').textContent = frameStats().fps.toFixed(0) + ' frames per second';
@@ -422,6 +525,7 @@
     robotScreenBox: robotScreenBox,
     // Robot and ghosts shown or hidden (the screenshot check compares both).
     showRobots(on) {
+      stillLayers.changed();
       robotLayer.visible = on;
     },
     play() { if (!play.playing) $('play').click(); },
@@ -429,8 +533,10 @@
     select: select,
     messages: messages,
     renderer: rendererName,
+    stillLayersCached: stillLayers.cached,
+    renderScale: renderScale,
   };
-  renderer.render(scene, camera);
+  stillLayers.render();
   body.setAttribute('data-robot-shapes', String(robot.shapes.length));
   body.setAttribute('data-obstacles', String(data.environment.obstacles.length));
   body.setAttribute('data-trajectories', String(trajectories.length));

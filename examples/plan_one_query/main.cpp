@@ -1,11 +1,13 @@
 // Plans one query on an edge bundle with the installed library:
-//   plan_one_query BUNDLE START GOAL [PLANNER [TOLERANCE]]
+//   plan_one_query BUNDLE START GOAL [PLANNER [TOLERANCE [BUDGET]]]
 // START and GOAL are comma-separated joint values; PLANNER a registered planner (default
-// lazyboe); TOLERANCE the joint-space goal radius in rad (default 0.3). Prints the result and
-// the re-validated trajectory's duration and cost; exit status 0 on success.
+// lazyboe); TOLERANCE the joint-space goal radius in rad (default 0.3); BUDGET the planning
+// time limit in s (default 5). Prints the result and the re-validated trajectory's duration and
+// cost; exit status 0 on success.
 #include <cstdio>
 #include <cstdlib>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -15,10 +17,18 @@
 
 namespace {
 
+// The whole text as a number, or std::invalid_argument ("0.3x" is not 0.3).
+double number(const std::string& text) {
+  std::size_t used = 0;
+  const double value = std::stod(text, &used);
+  if (used != text.size()) throw std::invalid_argument(text);
+  return value;
+}
+
 lazyboe::JointVector joints(const std::string& text) {
   std::vector<double> v;
   std::stringstream in(text);
-  for (std::string cell; std::getline(in, cell, ',');) v.push_back(std::stod(cell));
+  for (std::string cell; std::getline(in, cell, ',');) v.push_back(number(cell));
   return Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size()));
 }
 
@@ -26,7 +36,7 @@ lazyboe::JointVector joints(const std::string& text) {
 
 int main(int argc, char** argv) {
   if (argc < 4) {
-    std::fprintf(stderr, "usage: %s BUNDLE START GOAL [PLANNER [TOLERANCE]]\n", argv[0]);
+    std::fprintf(stderr, "usage: %s BUNDLE START GOAL [PLANNER [TOLERANCE [BUDGET]]]\n", argv[0]);
     return 2;
   }
   try {
@@ -38,8 +48,8 @@ int main(int argc, char** argv) {
     problem.start = joints(argv[2]);
     problem.goal.kind = lazyboe::Goal::Kind::Joint;
     problem.goal.q = joints(argv[3]);
-    problem.goal.tolerance = argc > 5 ? std::atof(argv[5]) : 0.3;
-    problem.termination.budget = 5.0;
+    problem.goal.tolerance = argc > 5 ? number(argv[5]) : 0.3;
+    problem.termination.budget = argc > 6 ? number(argv[6]) : 5.0;
     problem.termination.stop_at_first = true;
     lazyboe::validate_problem(session.sim, ws, problem);  // limits, collision, reach
 
@@ -60,5 +70,8 @@ int main(int argc, char** argv) {
   } catch (const lazyboe::Error& e) {
     std::fprintf(stderr, "plan_one_query: error: %s\n", e.what());
     return 1;
+  } catch (const std::logic_error&) {  // number(): not a number
+    std::fprintf(stderr, "plan_one_query: error: START, GOAL, TOLERANCE and BUDGET are numbers\n");
+    return 2;
   }
 }

@@ -177,7 +177,9 @@ void check_urdf_values(const std::string& xml_text, const std::string& path) {
   xml.Parse(xml_text.c_str());
   if (xml.Error() || !xml.RootElement()) return;  // reported by the caller
   walk(path, xml.RootElement());
-  check_tree(path, xml.RootElement());
+  // The <robot> urdfdom reads: the first top-level element of that name, which need not be the
+  // document's first element (a stray element before it; found by fuzzing).
+  if (const TiXmlElement* robot = xml.FirstChildElement("robot")) check_tree(path, robot);
 }
 
 }  // namespace lazyboe

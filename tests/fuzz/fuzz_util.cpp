@@ -45,7 +45,8 @@ const std::string& scratch_dir() {
 std::string write_scratch(const std::string& name, const uint8_t* data, size_t size) {
   const std::string path = scratch_dir() + "/" + name;
   std::FILE* f = std::fopen(path.c_str(), "wb");
-  if (!f || std::fwrite(data, 1, size, f) != size || std::fclose(f) != 0) {
+  // An empty input may come with a null `data`, which fwrite must not get.
+  if (!f || (size > 0 && std::fwrite(data, 1, size, f) != size) || std::fclose(f) != 0) {
     std::perror(("lazyboe fuzz: " + path).c_str());
     std::abort();  // the harness, not the parser: stop rather than fuzz a stale file
   }

@@ -130,10 +130,10 @@ class Chromium:
                 return event
 
     # -- page ------------------------------------------------------------------------------
-    def open(self, path):
-        """Loads a file and waits for its load event."""
+    def open(self, path, query=""):
+        """Loads a file (with an optional URL query, "scale=0.5") and waits for its load event."""
         self._events = [e for e in self._events if e.get("method") != "Page.loadEventFired"]
-        self.call("Page.navigate", {"url": "file://" + os.path.abspath(path)})
+        self.call("Page.navigate", {"url": "file://" + os.path.abspath(path) + ("?" + query if query else "")})
         self.wait_event("Page.loadEventFired")
 
     def evaluate(self, expression, await_promise=False):

@@ -63,10 +63,10 @@ def page_state(browser):
     return browser.evaluate("JSON.stringify(Object.assign({}, document.body.dataset))")
 
 
-def open_page(browser, path, name):
+def open_page(browser, path, name, query=""):
     """Loads a page, waits for its scene; checks status and console. Returns its data-* state."""
     browser.console_errors.clear()
-    browser.open(path)
+    browser.open(path, query)
     ready = browser.wait_for("document.body.dataset.status !== 'loading'", 30)
     state = json.loads(page_state(browser))
     check(ready and state.get("status") == "ready", f"{name}: scene ready ({state.get('status')})")
@@ -93,6 +93,56 @@ def nonblank_robot(browser, png_path, name):
     robot = sum(1 for x, y in points if far(shown[y][x], hidden[y][x]) and far(shown[y][x], BACKGROUND))
     share = robot / max(1, len(points))
     check(share > 0.05, f"{name}: the robot covers {share:.0%} of its box ({png_path})")
+
+
+def view_pixels(browser, png_path):
+    """The 3-D view's pixels in a screenshot taken after at least one more frame was drawn."""
+    frames = browser.evaluate("lazyboeView.frameStats().frames")
+    browser.wait_for(f"lazyboeView.frameStats().frames > {frames + 1}", 10)
+    rect = browser.evaluate("JSON.parse(JSON.stringify(document.getElementById('view').getBoundingClientRect()))")
+    pixels = chromium.read_png(browser.screenshot(png_path))[2]
+    x0, y0, x1, y1 = (int(rect[k]) for k in ("left", "top", "right", "bottom"))
+    return [row[x0:x1] for row in pixels[y0:y1]]
+
+
+def differing_share(a, b):
+    """Share of the pixels that differ by more than 24 in a channel."""
+    far = sum(1 for ra, rb in zip(a, b) for p, q in zip(ra, rb) if max(abs(u - v) for u, v in zip(p, q)) > 24)
+    return far / max(1, sum(len(r) for r in a))
+
+
+def drag(browser, dx):
+    """A left-button drag across the view's centre: OrbitControls turns the camera."""
+    rect = browser.evaluate("JSON.parse(JSON.stringify(document.getElementById('view').getBoundingClientRect()))")
+    x, y = (rect["left"] + rect["right"]) / 2, (rect["top"] + rect["bottom"]) / 2
+    mouse = lambda kind, px, buttons: browser.call("Input.dispatchMouseEvent", {  # noqa: E731
+        "type": kind, "x": px, "y": y, "button": "left", "buttons": buttons, "clickCount": 1})
+    mouse("mousePressed", x, 1)
+    for k in range(1, 9):
+        mouse("mouseMoved", x + dx * k / 8, 1)
+    mouse("mouseReleased", x + dx, 0)
+
+
+def cached_equals_direct(browser, page, out_dir):
+    """The still layers drawn once and reused (the default with a software renderer) give the
+    picture that drawing everything every frame gives, before and after the camera is turned
+    (the cache is redrawn when the view changes)."""
+    pictures = {}
+    for cache in ("0", "1"):
+        open_page(browser, page, f"page with cache={cache}", f"cache={cache}")
+        check(browser.evaluate("lazyboeView.stillLayersCached") == (cache == "1"),
+              f"cache={cache}: the still layers are {'' if cache == '1' else 'not '}cached")
+        png = os.path.join(out_dir, f"cache{cache}.png")
+        before = view_pixels(browser, png)
+        drag(browser, 120)
+        pictures[cache] = (before, view_pixels(browser, png))
+        os.remove(png)
+    turned = differing_share(*pictures["1"])
+    check(turned > 0.05, f"dragging turned the cached view ({turned:.1%} of the pixels changed)")
+    for i, when in enumerate(("before", "after")):
+        share = differing_share(pictures["0"][i], pictures["1"][i])
+        check(share < 0.002, f"cached and direct drawing agree {when} the camera turned "
+              f"({share:.3%} of the pixels differ)")
 
 
 def compare_fk(browser, bin_dir, configurations):
@@ -181,6 +231,8 @@ def main():
               any("thrown probe" in e for e in browser.console_errors),
               f"console errors and uncaught exceptions are caught by the test ({browser.console_errors})")
         browser.console_errors.clear()
+
+        cached_equals_direct(browser, main_page, out_dir)
 
         state = open_page(browser, only_failed, "failed-only page")
         text = browser.evaluate("document.body.innerText")
