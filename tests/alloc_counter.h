@@ -23,7 +23,7 @@ inline constexpr bool counts_allocations = LAZYBOE_TEST_COUNTS_ALLOCATIONS;
 }  // namespace lazyboe::test
 
 // The first statement of a test that reads `allocations`.
-#define LAZYBOE_SKIP_UNLESS_COUNTING_ALLOCATIONS()                                         \
-  if (!lazyboe::test::counts_allocations)                                                  \
+#define LAZYBOE_SKIP_UNLESS_COUNTING_ALLOCATIONS()                                          \
+  if (!lazyboe::test::counts_allocations)                                                   \
   GTEST_SKIP() << "allocations are not counted under ThreadSanitizer (its runtime defines " \
                   "operator new)"

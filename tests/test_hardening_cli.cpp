@@ -72,7 +72,8 @@ TEST(FullDisk, BuildPastTheFileSizeLimitFailsInOneLineAndLeavesNothing) {
   const std::string dir = fresh_dir("full-build");
   const std::string out = dir + "/out.h5";
   const CommandResult r =
-      tool("lazyboe-build", {"--edges", "300", "--out", out, "--quiet", kNoCheckpoint[0], kNoCheckpoint[1]},
+      tool("lazyboe-build",
+           {"--edges", "300", "--out", out, "--quiet", kNoCheckpoint[0], kNoCheckpoint[1]},
            /*file_limit_kib=*/100);
   expect_one_line_error(r, {out + ": cannot write", "File too large"});
   EXPECT_FALSE(contains(r.err, ".tmp.")) << r.err;  // the output is named, not its temporary
@@ -85,10 +86,10 @@ TEST(FullDisk, ResumedBuildPastTheLimitKeepsTheLastCheckpoint) {
   ASSERT_EQ(tool("lazyboe-build", {"--edges", "100", "--out", out, "--quiet"}).exit_code, 0);
   const std::string before = read_file(out);
   const long limit = static_cast<long>(before.size() / 1024) + 8;  // room for a few edges
-  const CommandResult r =
-      tool("lazyboe-build",
-           {"--resume", "--edges", "400", "--out", out, "--quiet", kNoCheckpoint[0], kNoCheckpoint[1]},
-           limit);
+  const CommandResult r = tool(
+      "lazyboe-build",
+      {"--resume", "--edges", "400", "--out", out, "--quiet", kNoCheckpoint[0], kNoCheckpoint[1]},
+      limit);
   expect_one_line_error(r, {out + ": cannot write", "File too large"});
   EXPECT_EQ(read_file(out), before);
   EXPECT_EQ(files_in(dir), std::vector<std::string>{"out.h5"});
