@@ -35,4 +35,4 @@ grep -q "goal.q: outside the joint limits" "$work/err" || { cat "$work/err"; exi
 if "$work/example/plan_one_query" "$work/b.h5" "$start" "$goal" rrt 0.3 abc 2> "$work/err"; then
   echo "FAIL: a budget that is not a number was accepted"; exit 1
 fi
-grep -q "are numbers" "$work/err" || { cat "$work/err"; exit 1; }
+grep -q "BUDGET: 'abc' is not a number" "$work/err" || { cat "$work/err"; exit 1; }

@@ -7,28 +7,22 @@
 #include <cstdio>
 #include <cstdlib>
 #include <sstream>
-#include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "lazyboe/common/error.h"
+#include "lazyboe/common/numbers.h"
 #include "lazyboe/planning/planning_session.h"
+#include "lazyboe/planning/problem.h"
 #include "lazyboe/planning/registry.h"
 
 namespace {
 
-// The whole text as a number, or std::invalid_argument ("0.3x" is not 0.3).
-double number(const std::string& text) {
-  std::size_t used = 0;
-  const double value = std::stod(text, &used);
-  if (used != text.size()) throw std::invalid_argument(text);
-  return value;
-}
-
 lazyboe::JointVector joints(const std::string& text) {
   std::vector<double> v;
   std::stringstream in(text);
-  for (std::string cell; std::getline(in, cell, ',');) v.push_back(number(cell));
+  for (std::string cell; std::getline(in, cell, ',');)
+    v.push_back(lazyboe::parse_real_in(cell, {-1e3, 1e3}, "joint value", " rad"));
   return Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size()));
 }
 
@@ -48,8 +42,13 @@ int main(int argc, char** argv) {
     problem.start = joints(argv[2]);
     problem.goal.kind = lazyboe::Goal::Kind::Joint;
     problem.goal.q = joints(argv[3]);
-    problem.goal.tolerance = argc > 5 ? number(argv[5]) : 0.3;
-    problem.termination.budget = argc > 6 ? number(argv[6]) : 5.0;
+    // Strict numbers (the whole text, finite), in the ranges lazyboe-query accepts.
+    problem.goal.tolerance =
+        argc > 5 ? lazyboe::parse_real_in(argv[5], {0, 1e3, true}, "TOLERANCE", " rad") : 0.3;
+    problem.termination.budget =
+        argc > 6
+            ? lazyboe::parse_real_in(argv[6], {0, lazyboe::kMaxBudgetSeconds, true}, "BUDGET", " s")
+            : 5.0;
     problem.termination.stop_at_first = true;
     lazyboe::validate_problem(session.sim, ws, problem);  // limits, collision, reach
 
@@ -70,8 +69,5 @@ int main(int argc, char** argv) {
   } catch (const lazyboe::Error& e) {
     std::fprintf(stderr, "plan_one_query: error: %s\n", e.what());
     return 1;
-  } catch (const std::logic_error&) {  // number(): not a number
-    std::fprintf(stderr, "plan_one_query: error: START, GOAL, TOLERANCE and BUDGET are numbers\n");
-    return 2;
   }
 }

@@ -45,10 +45,6 @@ Pose pose_from_urdf(const urdf::Pose& pose) {
               Eigen::Vector3d(pose.position.x, pose.position.y, pose.position.z));
 }
 
-std::string loop_message(const std::string& link) {
-  return "the joints form a loop through link '" + link + "' (a URDF must be a tree)";
-}
-
 urdf::ModelInterfaceSharedPtr parse_urdf_file(const std::string& path) {
   require_input_file(path, "URDF file");
   std::ifstream in(path);
@@ -309,7 +305,7 @@ std::vector<urdf::LinkConstSharedPtr> find_chain(const JsonField& root,
     // A chain longer than the URDF has links goes round a loop of joints (check_urdf_values
     // refuses them before urdfdom parses the file; this bound keeps the walk finite anyway).
     while (link && link != base) {
-      if (chain.size() > urdf_model.links_.size()) fail(upath, loop_message(link->name));
+      if (chain.size() > urdf_model.links_.size()) fail(upath, urdf_loop_message(link->name));
       chain.push_back(link);
       link = link->getParent();
     }
@@ -325,7 +321,7 @@ std::vector<urdf::LinkConstSharedPtr> find_chain(const JsonField& root,
              "the URDF branches at link '" + link->name + "'; set tip_link to choose the chain");
       }
       link = link->child_links[0];
-      if (chain.size() > urdf_model.links_.size()) fail(upath, loop_message(link->name));
+      if (chain.size() > urdf_model.links_.size()) fail(upath, urdf_loop_message(link->name));
       chain.push_back(link);
     }
   }

@@ -162,15 +162,17 @@ void check_tree(const std::string& path, const TiXmlElement* robot) {
     for (size_t steps = 0;; ++steps) {
       const auto up = parent_of.find(link);
       if (up == parent_of.end()) break;
-      if (steps > parent_of.size())
-        fail(where_of(path, first.joint),
-             "the joints form a loop through link '" + start + "' (a URDF must be a tree)");
+      if (steps > parent_of.size()) fail(where_of(path, first.joint), urdf_loop_message(start));
       link = up->second.parent;
     }
   }
 }
 
 }  // namespace
+
+std::string urdf_loop_message(const std::string& link) {
+  return "the joints form a loop through link '" + link + "' (a URDF must be a tree)";
+}
 
 void check_urdf_values(const std::string& xml_text, const std::string& path) {
   TiXmlDocument xml;

@@ -13,4 +13,8 @@ namespace lazyboe {
 // XML.
 void check_urdf_values(const std::string& xml_text, const std::string& path);
 
+// "the joints form a loop through link 'l' (a URDF must be a tree)": the check above and the
+// chain walk of load_robot say it the same way.
+std::string urdf_loop_message(const std::string& link);
+
 }  // namespace lazyboe

@@ -75,6 +75,16 @@ def open_page(browser, path, name, query=""):
     return state
 
 
+def far(p, q):
+    """Two pixels differ by more than 24 in a channel."""
+    return max(abs(a - b) for a, b in zip(p, q)) > 24
+
+
+def view_rect(browser):
+    """The 3-D view's box on the page, in CSS pixels."""
+    return browser.evaluate("JSON.parse(JSON.stringify(document.getElementById('view').getBoundingClientRect()))")
+
+
 def nonblank_robot(browser, png_path, name):
     """The screenshot is not blank where the robot is: in the robot's box on the page, at least
     a twentieth of the pixels differ from the same view with the robot (and its ghosts) hidden,
@@ -88,7 +98,6 @@ def nonblank_robot(browser, png_path, name):
     x0, y0 = max(0, int(box["x0"])), max(0, int(box["y0"]))
     x1, y1 = min(width, int(math.ceil(box["x1"]))), min(height, int(math.ceil(box["y1"])))
     check(x1 - x0 > 20 and y1 - y0 > 20, f"{name}: robot's box on screen {box}")
-    far = lambda p, q: max(abs(a - b) for a, b in zip(p, q)) > 24  # noqa: E731
     points = [(x, y) for y in range(y0, y1, 2) for x in range(x0, x1, 2)]
     robot = sum(1 for x, y in points if far(shown[y][x], hidden[y][x]) and far(shown[y][x], BACKGROUND))
     share = robot / max(1, len(points))
@@ -99,21 +108,21 @@ def view_pixels(browser, png_path):
     """The 3-D view's pixels in a screenshot taken after at least one more frame was drawn."""
     frames = browser.evaluate("lazyboeView.frameStats().frames")
     browser.wait_for(f"lazyboeView.frameStats().frames > {frames + 1}", 10)
-    rect = browser.evaluate("JSON.parse(JSON.stringify(document.getElementById('view').getBoundingClientRect()))")
+    rect = view_rect(browser)
     pixels = chromium.read_png(browser.screenshot(png_path))[2]
     x0, y0, x1, y1 = (int(rect[k]) for k in ("left", "top", "right", "bottom"))
     return [row[x0:x1] for row in pixels[y0:y1]]
 
 
 def differing_share(a, b):
-    """Share of the pixels that differ by more than 24 in a channel."""
-    far = sum(1 for ra, rb in zip(a, b) for p, q in zip(ra, rb) if max(abs(u - v) for u, v in zip(p, q)) > 24)
-    return far / max(1, sum(len(r) for r in a))
+    """Share of the pixels that are far() apart."""
+    differing = sum(1 for ra, rb in zip(a, b) for p, q in zip(ra, rb) if far(p, q))
+    return differing / max(1, sum(len(r) for r in a))
 
 
 def drag(browser, dx):
     """A left-button drag across the view's centre: OrbitControls turns the camera."""
-    rect = browser.evaluate("JSON.parse(JSON.stringify(document.getElementById('view').getBoundingClientRect()))")
+    rect = view_rect(browser)
     x, y = (rect["left"] + rect["right"]) / 2, (rect["top"] + rect["bottom"]) / 2
     mouse = lambda kind, px, buttons: browser.call("Input.dispatchMouseEvent", {  # noqa: E731
         "type": kind, "x": px, "y": y, "button": "left", "buttons": buttons, "clickCount": 1})
