@@ -6,7 +6,7 @@ set -euo pipefail
 packages=(
   build-essential cmake pkg-config
   libeigen3-dev libfcl-dev liburdfdom-dev libtinyxml-dev libhdf5-dev libcli11-dev
-  nlohmann-json3-dev libnanoflann-dev
+  nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   python3 python3-jsonschema
   # The Python module (python/) and its tests: built for and run by Debian's /usr/bin/python3.

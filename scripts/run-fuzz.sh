@@ -12,13 +12,14 @@ runs=${3:-0}
 shift $(( $# < 3 ? $# : 3 ))
 src=$(cd "$(dirname "$0")/.." && pwd)
 targets=("$@")
-[[ ${#targets[@]} -gt 0 ]] || targets=(robot_config urdf environment query_line problems csv trajectory_csv bundle runs_csv)
+[[ ${#targets[@]} -gt 0 ]] || targets=(robot_config urdf environment query_line problems csv trajectory_csv bundle runs_csv edge_index)
 
 # Inputs a little larger than the largest seed (the Panda URDF is 12 kB, a bundle 16 to 20 kB).
 max_len() {
   case $1 in
     urdf) echo 16384 ;;
     bundle) echo 24576 ;;
+    edge_index) echo 8192 ;;
     robot_config) echo 8192 ;;
     *) echo 4096 ;;
   esac

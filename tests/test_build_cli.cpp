@@ -461,7 +461,7 @@ TEST(BuildCli, ExistingOutputIsOnlyReplacedWithForce) {
   EXPECT_EQ(b.header.seed, 2u);
   EXPECT_TRUE(b.header.complete);
   EXPECT_EQ(b.size(), 60u);
-  EXPECT_EQ(files_in(dir), std::vector<std::string>{"b.h5"});
+  EXPECT_EQ(files_in(dir), (std::vector<std::string>{"b.h5", "b.h5.kd-index"}));
 }
 
 // ------------------------------------------------------------------------------------------
@@ -667,7 +667,7 @@ TEST(BuildCli, FreshBundleFollowsTheSchema) {
   const std::string out = dir + "/b.h5";
   const CommandResult r = build_tool({"--out", out, "--edges", "150", "--seed", "7", "--quiet"});
   ASSERT_EQ(r.exit_code, 0) << describe(r);
-  EXPECT_EQ(files_in(dir), std::vector<std::string>{"b.h5"});
+  EXPECT_EQ(files_in(dir), (std::vector<std::string>{"b.h5", "b.h5.kd-index"}));
 
   const Bundle b = read_bundle(out);
   const BundleHeader& h = b.header;
@@ -820,7 +820,50 @@ TEST(BuildCli, QuietPrintsNothing) {
   EXPECT_EQ(r.exit_code, 0);
   EXPECT_EQ(r.out, "");
   EXPECT_EQ(r.err, "");
-  EXPECT_EQ(files_in(dir), std::vector<std::string>{"b.h5"});
+  EXPECT_EQ(files_in(dir), (std::vector<std::string>{"b.h5", "b.h5.kd-index"}));
+}
+
+// ------------------------------------------------------------------------------------------
+// 8. The k-d tree index beside the bundle
+// ------------------------------------------------------------------------------------------
+
+// Every finished build writes it, planning maps it, and --index writes the same file again for
+// a bundle that has none.
+TEST(BuildCli, AFinishedBuildWritesTheKdTreeIndexThatPlanningMaps) {
+  const std::string dir = fresh_dir("kd-index");
+  const std::string out = dir + "/b.h5", index = out + ".kd-index";
+  const CommandResult built = build_tool({"--out", out, "--edges", "300", "--threads", "2"});
+  ASSERT_EQ(built.exit_code, 0) << describe(built);
+  EXPECT_TRUE(contains(built.err, "k-d tree index written to " + index)) << built.err;
+  const std::string written = read_file(index);
+
+  const std::string queries = write_temp_file("no-queries.jsonl", "");
+  const std::string query = watchdog(60) + quote(tool_path("lazyboe-query")) + " --bundle " +
+                            quote(out) + " --queries " + quote(queries) + " --out " +
+                            quote(dir + "/results.jsonl");
+  CommandResult r = run(query);
+  ASSERT_EQ(r.exit_code, 0) << describe(r);
+  EXPECT_TRUE(contains(r.err, "k-d trees mapped from " + index)) << r.err;
+
+  fs::remove(index);
+  r = run(query);
+  EXPECT_TRUE(contains(r.err, "k-d trees built at load (no index file)")) << r.err;
+  r = build_tool({"--index", out});
+  ASSERT_EQ(r.exit_code, 0) << describe(r);
+  EXPECT_TRUE(read_file(index) == written) << "--index wrote another file than the build";
+
+  const CommandResult missing = build_tool({"--index", dir + "/none.h5"});
+  expect_one_line_error(missing, {dir + "/none.h5", "cannot open"});
+  EXPECT_FALSE(fs::exists(dir + "/none.h5.kd-index"));
+
+  // An index that cannot be written does not fail the build it goes with.
+  const std::string other = dir + "/other.h5";
+  fs::create_directory(other + ".kd-index");
+  r = build_tool({"--out", other, "--edges", "60"});
+  ASSERT_EQ(r.exit_code, 0) << describe(r);
+  EXPECT_TRUE(contains(r.err, "warning: " + other + ".kd-index: cannot write: is a directory"))
+      << r.err;
+  EXPECT_TRUE(read_bundle(other).header.complete);
 }
 
 }  // namespace

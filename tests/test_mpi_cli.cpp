@@ -5,11 +5,13 @@
 #include <gtest/gtest.h>
 #include <signal.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <string>
 #include <vector>
 
 #include "cli_util.h"
+#include "lazyboe/bundle/bundle_file.h"
 #include "lazyboe/bundle/checkpoint_journal.h"
 #include "test_util.h"
 
@@ -161,6 +163,28 @@ TEST(Mpi, RankKilledMidPerturbResumesWithAnotherRankCountToTheSameFile) {
   const CommandResult again = run(command(2, "lazyboe-perturb", perturb_args(out)));
   ASSERT_EQ(again.exit_code, 0) << describe(again);
   EXPECT_TRUE(same_bundle_but_timings(out, single_perturbed(), 2));
+}
+
+// Ctrl-C on mpirun kills the ranks; SIGUSR1, which mpirun forwards, stops the job as Ctrl-C
+// stops one process: rank 0 saves the whole bundle so far (a prefix of the straight build's
+// edges), the other ranks end, the exit status is 130.
+TEST(Mpi, SigusrOnMpirunStopsTheJobWithAFinalSave) {
+  REQUIRE_MPI();
+  const std::string out = fresh_dir("usr1") + "/mpi.h5";
+  std::vector<std::string> args = build_args(out);
+  args[7] = "1000000";  // --edges: far more than the job can make before the signal
+  const std::string cmd = "(" + command(2, "lazyboe-build", args) + " & job=$!; while [ ! -e " +
+                          quote(out) + " ]; do sleep 0.1; done; pkill -USR1 -P $job; wait $job; " +
+                          "echo exit $?)";
+  const CommandResult r = run(cmd);
+  EXPECT_TRUE(contains(r.out, "exit 130")) << describe(r);
+  EXPECT_TRUE(contains(r.err, "lazyboe-build: interrupted; " + out + " holds ")) << r.err;
+  EXPECT_FALSE(fs::exists(build_journal_path(out))) << "no final save";
+  const Bundle stopped = read_bundle(out), straight = read_bundle(single_build());
+  EXPECT_FALSE(stopped.header.complete);
+  ASSERT_GT(stopped.size(), 0u);
+  const size_t n = std::min(stopped.size(), straight.size()) * 7;
+  EXPECT_TRUE(std::equal(stopped.q0.begin(), stopped.q0.begin() + n, straight.q0.begin()));
 }
 
 // A rank that cannot open the environment (a relative path, another working directory: the

@@ -3,6 +3,7 @@
 
 #include <string>
 
+#include "lazyboe/bundle/bundle.h"
 #include "lazyboe/collision/collision_model.h"
 #include "lazyboe/robot/robot_model.h"
 #include "lazyboe/sim/simulator.h"
@@ -24,6 +25,12 @@ struct Scene {
   CollisionModel collision;
   Simulator sim;
 };
+
+// A complete bundle of n edges with random contents in [-3, 3] (not simulated), ragged knots
+// (0..5 per edge) and samples (1..12): for the file and index formats.
+Bundle random_bundle(size_t n, int dof, uint64_t seed);
+// One a BundleView accepts: at least two knots per edge, a finished perturbation analysis.
+Bundle viewable_bundle(size_t n, int dof, uint64_t seed);
 
 // A fresh directory under the system temp dir, removed at exit.
 std::string temp_dir();

@@ -1,6 +1,7 @@
 // lazyboe-build: generate the edge bundle (valid random rollouts of the robot's dynamics) in
 // parallel and store it in HDF5; or --inspect an existing bundle.
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -13,6 +14,7 @@
 #include "lazyboe/common/file_checks.h"
 #include "lazyboe/common/json_fields.h"
 #include "lazyboe/common/version.h"
+#include "lazyboe/planning/edge_index_file.h"
 #include "mpi_build.h"
 #include "mpi_offline.h"
 #include "tool_main.h"
@@ -84,7 +86,8 @@ void print_summary(const Bundle& b) {
 // The command line. Settings go straight into `settings`, except those that need the robot.
 struct BuildOptions {
   std::string robot_path = default_robot_path(), env_path = default_environment_path();
-  std::string out_path, inspect_path, verify_path, region = "default", integrator = "euler";
+  std::string out_path, inspect_path, verify_path, index_path, region = "default",
+                                                               integrator = "euler";
   BuildSettings settings;
   BuildControl control;
   double sample_interval = 0.05;
@@ -152,6 +155,9 @@ void add_options(CLI::App& app, BuildOptions& o) {
                  "Print the header and statistics of a bundle, then exit");
   app.add_option("--verify", o.verify_path,
                  "Check every dataset's checksum and the bundle's validity, then exit");
+  app.add_option("--index", o.index_path,
+                 "Write the k-d tree index beside a finished bundle (FILE.kd-index; every build "
+                 "writes one), then exit");
 }
 
 // Checks the options that need no file, in the order of their messages' precedence.
@@ -245,6 +251,29 @@ void report_replay(const JournalReplay& r, const Bundle& b, const BuildOptions& 
                  r.ignored_bytes ? "; a torn last checkpoint was dropped" : "");
 }
 
+// The k-d tree index beside a finished bundle, so that planning maps its trees instead of
+// building them at load.
+void write_index(const std::string& path, bool quiet) {
+  const auto started = std::chrono::steady_clock::now();
+  write_bundle_index(BundleView::open(path));
+  if (quiet) return;
+  std::fprintf(stderr, "lazyboe-build: k-d tree index written to %s (%.2f s)\n",
+               edge_index_path(path).c_str(),
+               std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count());
+}
+
+// After a finished build the index is a convenience: failing to write it leaves a good bundle.
+void try_write_index(const std::string& path, bool quiet) {
+  try {
+    write_index(path, quiet);
+  } catch (const Error& e) {
+    std::fprintf(stderr,
+                 "lazyboe-build: warning: %s; planning will build the k-d trees at load "
+                 "(write the index later with lazyboe-build --index %s)\n",
+                 e.what(), path.c_str());
+  }
+}
+
 // Builds (or resumes) the bundle until complete or interrupted; returns the exit status.
 int grow_bundle(const Simulator& sim, BuildOptions& o, Bundle& bundle,
                 BuildCheckpoints& checkpoints) {
@@ -284,6 +313,7 @@ int grow_bundle(const Simulator& sim, BuildOptions& o, Bundle& bundle,
                  o.out_path.c_str(), bundle.size(), o.out_path.c_str());
     return 130;
   }
+  try_write_index(o.out_path, o.control.quiet);
   return 0;
 }
 
@@ -309,8 +339,13 @@ int verify(const std::string& path) {
 
 int run(const CLI::App& app, BuildOptions& o) {
   if (!o.verify_path.empty()) return verify(o.verify_path);
+  if (!o.index_path.empty()) {
+    write_index(o.index_path, false);
+    return 0;
+  }
   if (!o.inspect_path.empty()) {
     print_inspection(o.inspect_path, stdout);
+    print_files_beside(o.inspect_path, stdout);
     return 0;
   }
   check_options(o);

@@ -119,6 +119,7 @@ void report_load(const Options& o, const PlanningSession& session) {
       stderr, "lazyboe-query: %s: %zu edges loaded in %.3f s (%s), resident memory %.0f MiB\n",
       o.bundle_path.c_str(), bundle.size(), session.load_seconds,
       bundle.memory_mapped() ? "memory-mapped" : "read into memory", resident_memory_mib());
+  std::fprintf(stderr, "lazyboe-query: k-d trees %s\n", session.indexes.source.c_str());
 }
 
 // A query id names its trajectory file: it must stay inside --trajectory-dir.

@@ -140,6 +140,7 @@ int run_tool_on_ranks(const char* tool, bool mpi_required, int& argc, char**& ar
   if (launched > 0 || mpi_required) {
     init(argc, argv);
     if (world().rank != 0) {
+      std::signal(SIGUSR1, SIG_IGN);  // sent to every rank; rank 0 stops the job, with a save
       try {
         serve();
       } catch (const std::exception& e) {

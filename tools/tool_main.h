@@ -66,8 +66,10 @@ inline CLI::Validator number_at_least_zero() {
       "NUM>=0");
 }
 
-// SIGINT/SIGTERM handling for long jobs. The first signal asks for a checkpoint and a clean
-// stop (stop_requested() turns true). A second one more than a second later (a user pressing
+// SIGINT/SIGTERM handling for long jobs, and SIGUSR1 for jobs under mpirun or Slurm (mpirun
+// kills the ranks on Ctrl-C but forwards SIGUSR1 to them; `sbatch --signal` sends it before a
+// time limit). The first signal asks for a checkpoint and a clean stop (stop_requested() turns
+// true). A second one more than a second later (a user pressing
 // Ctrl-C again) ends the process at once; the last checkpoint on disk stays valid. Duplicates
 // within a second (a signal sent to the whole process group, as `timeout` does) are ignored.
 namespace detail {
@@ -91,6 +93,7 @@ inline void on_stop_signal(int) {
 inline void install_stop_handlers() {
   std::signal(SIGINT, detail::on_stop_signal);
   std::signal(SIGTERM, detail::on_stop_signal);
+  std::signal(SIGUSR1, detail::on_stop_signal);
 }
 inline bool stop_requested() { return detail::g_stop.load(); }
 

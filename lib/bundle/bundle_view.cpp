@@ -21,6 +21,22 @@ namespace ds = bundle_dataset;
 
 void FileUnmap::operator()(void* address) const { ::munmap(address, bytes); }
 
+namespace {
+
+// The checksum attribute of the datasets, space-separated; empty when one has none.
+std::string stored_checksums(const std::string& path, long file,
+                             std::initializer_list<const char*> datasets) {
+  std::string out;
+  for (const char* name : datasets) {
+    const h5::Dataset dset = h5::open_dataset(path, file, name);
+    if (!h5::has_attribute(dset, kChecksumAttribute)) return "";
+    out += (out.empty() ? "" : " ") + h5::read_attr_string(path, dset, kChecksumAttribute);
+  }
+  return out;
+}
+
+}  // namespace
+
 CommandProfile BundleView::command(size_t e) const {
   const int n = dof();
   return CommandProfile{knots_ + knot_offset_[e] * n,
@@ -86,6 +102,7 @@ BundleView BundleView::open(const std::string& path, bool allow_mmap) {
   h5::File file = h5::open_file(path);
   v.q0_ = v.attach<double>(file, ds::q0, {n, dof}, allow_mmap);
   v.qf_ = v.attach<double>(file, ds::qf, {n, dof}, allow_mmap);
+  v.states_checksum_ = stored_checksums(path, file, {ds::q0, ds::qf});
   v.duration_ = v.attach<double>(file, ds::duration, {n}, allow_mmap);
   v.command_duration_ = v.attach<double>(file, ds::command_duration, {n}, allow_mmap);
   v.knot_offset_ = v.attach<uint64_t>(file, ds::knot_offset, {n + 1}, allow_mmap);

@@ -61,6 +61,10 @@ class BundleView {
   const double* transfer_max_error_data() const { return transfer_max_error_; }
 
   bool memory_mapped() const { return all_mapped_; }  // every dataset mapped
+  // The checksums stored with the q0 and qf datasets, "<q0> <qf>": what ties an index file
+  // (edge_index_file.h) to these edge states. Empty for a file written before checksums and
+  // for an in-memory view.
+  const std::string& states_checksum() const { return states_checksum_; }
   const std::vector<std::string>& warnings() const { return warnings_; }
 
  private:
@@ -82,6 +86,7 @@ class BundleView {
   bool all_mapped_ = false;
   std::vector<std::shared_ptr<const void>> owned_;
   std::vector<std::string> warnings_;
+  std::string states_checksum_;
 
   const double* q0_ = nullptr;
   const double* qf_ = nullptr;

@@ -1,56 +1,232 @@
 #include "lazyboe/planning/neighbour_index.h"
 
 #include <algorithm>
-#include <nanoflann.hpp>
+#include <array>
+#include <numeric>
+#include <string>
+
+#include "lazyboe/common/error.h"
+#include "lazyboe/robot/types.h"
 
 namespace lazyboe {
 
 namespace {
 
-// nanoflann's view of the edge starts (or ends): `count` rows of `dof` values. The row pointer is
-// taken once, not per coordinate: nanoflann reads a coordinate at a time in its inner loops.
-struct EdgeRows {
-  EdgePoint point;
+constexpr int kMaxDepth = 64;  // a median split tree over 2^32 points is 29 deep
+
+const double* point_rows(const BundleView& b, EdgePoint point) {
+  if (b.size() == 0) return nullptr;
+  return point == EdgePoint::Start ? b.q0(0) : b.qf(0);
+}
+
+// The tree over `count` rows of `dof` values: median splits in the dimension of the largest
+// spread (estimated from about kSpreadSample points of a node, evenly spaced), ties between
+// equal coordinates broken by id so that the tree depends on the points alone. The split itself
+// runs on a contiguous (coordinate, id) copy: selecting through the ids is cache-bound.
+class TreeBuilder {
+ public:
+  TreeBuilder(const double* rows, size_t count, int dof) : rows_(rows), dof_(dof) {
+    order.resize(count);
+    std::iota(order.begin(), order.end(), 0u);
+    keys_.resize(count);
+    nodes.reserve(2 * count / EdgeIndex::kLeafSize + 1);
+    lower.assign(static_cast<size_t>(dof), 0.0);
+    upper.assign(static_cast<size_t>(dof), 0.0);
+    if (count > 0) bounds(0, static_cast<uint32_t>(count), 1, lower.data(), upper.data());
+    make(0, static_cast<uint32_t>(count));
+    std::vector<Key>().swap(keys_);  // scratch: the tree keeps only its arrays
+  }
+
+  std::vector<KdNode> nodes;
+  std::vector<uint32_t> order;
+  std::vector<double> lower, upper;
+
+ private:
+  static constexpr uint32_t kSpreadSample = 256;
+  using Key = std::pair<double, uint32_t>;  // coordinate, id
+
+  double at(uint32_t id, int dim) const { return rows_[size_t{id} * dof_ + dim]; }
+
+  // The box of the points order[begin], order[begin + stride], ... below end.
+  void bounds(uint32_t begin, uint32_t end, uint32_t stride, double* lo, double* hi) const {
+    for (int d = 0; d < dof_; ++d) lo[d] = hi[d] = at(order[begin], d);
+    for (uint32_t i = begin + stride; i < end; i += stride) {
+      for (int d = 0; d < dof_; ++d) {
+        lo[d] = std::min(lo[d], at(order[i], d));
+        hi[d] = std::max(hi[d], at(order[i], d));
+      }
+    }
+  }
+
+  int widest_dimension(uint32_t begin, uint32_t end, uint32_t stride) const {
+    std::array<double, kMaxDof> lo{}, hi{};
+    bounds(begin, end, stride, lo.data(), hi.data());
+    int widest = 0;
+    for (int d = 1; d < dof_; ++d)
+      if (hi[d] - lo[d] > hi[widest] - lo[widest]) widest = d;
+    return widest;
+  }
+
+  // Splits order[begin, end) at its median in `dim`; false when all coordinates are equal.
+  bool split(uint32_t begin, uint32_t end, int dim, KdNode& node) {
+    const auto keys = keys_.begin() + begin, keys_end = keys_.begin() + end;
+    for (uint32_t i = begin; i < end; ++i) keys_[i] = Key{at(order[i], dim), order[i]};
+    const uint32_t mid = begin + (end - begin) / 2;
+    std::nth_element(keys, keys_.begin() + mid, keys_end);
+    const double high = keys_[mid].first;  // the smallest on the right, by nth_element
+    double low = keys[0].first;
+    for (uint32_t i = begin + 1; i < mid; ++i) low = std::max(low, keys_[i].first);
+    if (low == high &&
+        std::min_element(keys, keys_end)->first == std::max_element(keys, keys_end)->first)
+      return false;
+    for (uint32_t i = begin; i < end; ++i) order[i] = keys_[i].second;
+    node = KdNode{low, high, 0, 0, static_cast<uint32_t>(dim), 0};
+    return true;
+  }
+
+  uint32_t make(uint32_t begin, uint32_t end) {
+    const uint32_t self = static_cast<uint32_t>(nodes.size());
+    nodes.emplace_back();
+    KdNode node;
+    const uint32_t sampled = std::max(1u, (end - begin) / kSpreadSample);
+    // All sampled points equal in the widest sampled dimension: the exact widest one.
+    if (end - begin <= EdgeIndex::kLeafSize ||
+        !(split(begin, end, widest_dimension(begin, end, sampled), node) ||
+          split(begin, end, widest_dimension(begin, end, 1), node))) {
+      nodes[self].first = begin;
+      nodes[self].second = end;
+      return self;
+    }
+    const uint32_t mid = begin + (end - begin) / 2;
+    node.first = make(begin, mid);
+    node.second = make(mid, end);
+    nodes[self] = node;
+    return self;
+  }
+
+  const double* rows_;
+  int dof_;
+  std::vector<Key> keys_;
+};
+
+// The search's state: the query, the squared radius, and the distance from q to the current
+// node's cell per dimension (the incremental bound of Arya and Mount, as nanoflann does).
+struct Search {
+  const KdTreeArrays& tree;
   const double* rows;
-  size_t count, dof;
-  size_t kdtree_get_point_count() const { return count; }
-  double kdtree_get_pt(size_t idx, size_t dim) const { return rows[idx * dof + dim]; }
-  template <class BBox>
-  bool kdtree_get_bbox(BBox&) const {
-    return false;
+  int dof;
+  const double* q;
+  double r2, prune;  // prune: r2 with a margin, so that rounding in the bound never drops a point
+  std::array<double, kMaxDof> cell{};
+  std::vector<std::pair<uint32_t, double>>& out;
+
+  void leaf(const KdNode& n) const {
+    for (uint32_t i = n.first; i < n.second; ++i) {
+      const uint32_t id = tree.order[i];
+      const double* p = rows + size_t{id} * dof;
+      double d = 0;
+      for (int k = 0; k < dof; ++k) {
+        const double diff = q[k] - p[k];
+        d += diff * diff;
+      }
+      if (d < r2) out.emplace_back(id, d);
+    }
+  }
+
+  void visit(uint32_t node, double bound) {
+    const KdNode& n = tree.nodes[node];
+    if (n.dim == KdNode::kLeaf) return leaf(n);
+    const double to_low = q[n.dim] - n.low, to_high = q[n.dim] - n.high;
+    const bool left_first = to_low + to_high < 0;
+    const double far_gap = left_first ? to_high * to_high : to_low * to_low;
+    visit(left_first ? n.first : n.second, bound);
+    const double saved = cell[n.dim];
+    const double far_bound = bound + far_gap - saved;
+    if (far_bound <= prune) {
+      cell[n.dim] = far_gap;
+      visit(left_first ? n.second : n.first, far_bound);
+      cell[n.dim] = saved;
+    }
   }
 };
 
-using Tree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, EdgeRows>,
-                                                 EdgeRows, -1, uint32_t>;
+// Walks the tree once: every node reached once from the root, children after their parent,
+// leaves covering order[] in sequence, depth bounded; and order[] a permutation of the ids.
+void check_tree(const KdTreeArrays& t, size_t points, int dof, const std::string& where) {
+  const auto bad = [&](const std::string& what) { fail(where, "malformed k-d tree: " + what); };
+  if (t.node_count == 0 || t.node_count > 2 * points + 1) bad("node count");
+  std::vector<bool> seen(points, false);
+  for (size_t i = 0; i < points; ++i) {
+    if (t.order[i] >= points || seen[t.order[i]]) bad("point order is not a permutation");
+    seen[t.order[i]] = true;
+  }
+  std::vector<std::pair<uint64_t, int>> stack{{0, 0}};  // node, depth
+  uint64_t next_point = 0, reached = 0;
+  while (!stack.empty()) {
+    const auto [index, depth] = stack.back();
+    stack.pop_back();
+    const KdNode& n = t.nodes[index];
+    ++reached;
+    if (n.dim == KdNode::kLeaf) {
+      if (n.first != next_point || n.second < n.first || n.second > points) bad("leaf range");
+      next_point = n.second;
+      continue;
+    }
+    if (n.dim >= static_cast<uint32_t>(dof) || !(n.low <= n.high)) bad("split");
+    if (n.first <= index || n.second <= index || n.first >= t.node_count ||
+        n.second >= t.node_count || depth >= kMaxDepth)
+      bad("child link");
+    stack.emplace_back(n.second, depth + 1);  // the left child is walked first
+    stack.emplace_back(n.first, depth + 1);
+  }
+  if (next_point != points || reached != t.node_count) bad("leaves do not cover the points");
+}
 
 }  // namespace
 
 struct EdgeIndex::Impl {
-  EdgeRows points;
-  Tree tree;
-  Impl(const BundleView& b, EdgePoint point)
-      : points{point,
-               b.size() == 0               ? nullptr
-               : point == EdgePoint::Start ? b.q0(0)
-                                           : b.qf(0),
-               b.size(), static_cast<size_t>(b.dof())},
-        tree(b.dof(), points, nanoflann::KDTreeSingleIndexAdaptorParams(16)) {
-    tree.buildIndex();
-  }
+  EdgePoint point;
+  const double* rows;
+  int dof;
+  KdTreeArrays arrays;
+  std::shared_ptr<const void> storage;  // what `arrays` point into
 };
 
 EdgeIndex::EdgeIndex(const BundleView& bundle, EdgePoint point)
-    : impl_(std::make_unique<Impl>(bundle, point)) {}
+    : impl_(std::make_unique<Impl>(
+          Impl{point, point_rows(bundle, point), bundle.dof(), KdTreeArrays{}, nullptr})) {
+  auto built = std::make_shared<TreeBuilder>(impl_->rows, bundle.size(), bundle.dof());
+  impl_->arrays = KdTreeArrays{built->nodes.data(), built->nodes.size(), built->order.data(),
+                               built->lower.data(), built->upper.data()};
+  impl_->storage = std::move(built);
+}
+
+EdgeIndex::EdgeIndex(const BundleView& bundle, EdgePoint point, const KdTreeArrays& arrays,
+                     std::shared_ptr<const void> storage, const std::string& where)
+    : impl_(std::make_unique<Impl>(
+          Impl{point, point_rows(bundle, point), bundle.dof(), arrays, std::move(storage)})) {
+  check_tree(arrays, bundle.size(), bundle.dof(), where);
+}
+
 EdgeIndex::~EdgeIndex() = default;
 
-EdgePoint EdgeIndex::point() const { return impl_->points.point; }
+EdgePoint EdgeIndex::point() const { return impl_->point; }
+const KdTreeArrays& EdgeIndex::arrays() const { return impl_->arrays; }
 
 void EdgeIndex::within(const double* q, double radius,
                        std::vector<std::pair<uint32_t, double>>& out) const {
-  nanoflann::SearchParams params;
-  params.sorted = false;
-  impl_->tree.radiusSearch(q, radius * radius, out, params);  // squared distances for L2_Simple
+  out.clear();
+  const Impl& m = *impl_;
+  if (m.rows == nullptr) return;
+  const double r2 = radius * radius;
+  Search s{m.arrays, m.rows, m.dof, q, r2, r2 * (1 + 1e-9), {}, out};
+  double bound = 0;
+  for (int d = 0; d < m.dof; ++d) {
+    const double gap = std::max({m.arrays.lower[d] - q[d], q[d] - m.arrays.upper[d], 0.0});
+    s.cell[d] = gap * gap;
+    bound += s.cell[d];
+  }
+  if (bound <= s.prune) s.visit(0, bound);
   std::sort(out.begin(), out.end());
 }
 

@@ -1,7 +1,9 @@
 // RADIAL_NN over the bundle's edge start states (the planners' neighbourhoods) or end states
-// (goal coverage): a k-d tree (nanoflann) built at load.
+// (goal coverage): a k-d tree in flat arrays, built at load or mapped from the bundle's index
+// file (edge_index_file.h), which holds the same arrays.
 #pragma once
 
+#include <cstdint>
 #include <memory>
 #include <utility>
 #include <vector>
@@ -13,18 +15,51 @@ namespace lazyboe {
 // Which state of every edge an index holds.
 enum class EdgePoint { Start, End };
 
+// One node of a k-d tree, as stored in memory and in the index file (32 bytes, no padding).
+struct KdNode {
+  static constexpr uint32_t kLeaf = 0xffffffffu;
+  // Internal node: the largest coordinate `dim` of a point on the left (low) and the smallest
+  // on the right (high); the children are nodes `first` (left) and `second`, both after this
+  // one. Leaf (dim == kLeaf): the points order[first, second).
+  double low = 0, high = 0;
+  uint32_t first = 0, second = 0;
+  uint32_t dim = kLeaf;
+  uint32_t reserved = 0;
+};
+static_assert(sizeof(KdNode) == 32, "KdNode is a file format");
+
+// A k-d tree's arrays, owned elsewhere: nodes in depth-first order (node 0 the root, leaves
+// left to right covering order[] in sequence), the point ids leaf by leaf, and the points'
+// bounding box (dof values each).
+struct KdTreeArrays {
+  const KdNode* nodes = nullptr;
+  uint64_t node_count = 0;
+  const uint32_t* order = nullptr;  // bundle size() ids, a permutation
+  const double* lower = nullptr;
+  const double* upper = nullptr;
+};
+
 class EdgeIndex {
  public:
+  static constexpr uint32_t kLeafSize = 16;
+
+  // Builds the tree over the bundle's edge starts (or ends).
   explicit EdgeIndex(const BundleView& bundle, EdgePoint point = EdgePoint::Start);
+  // A tree read from an index file: `arrays` point into `storage`, which the index keeps alive.
+  // Throws Error (naming `where`) unless the arrays form a well-shaped tree over the bundle's
+  // edges (every id once, leaves in sequence, children after parents, depth at most 64).
+  EdgeIndex(const BundleView& bundle, EdgePoint point, const KdTreeArrays& arrays,
+            std::shared_ptr<const void> storage, const std::string& where);
   ~EdgeIndex();
   EdgeIndex(const EdgeIndex&) = delete;
   EdgeIndex& operator=(const EdgeIndex&) = delete;
 
   EdgePoint point() const;
+  const KdTreeArrays& arrays() const;  // for writing the tree to an index file
 
   // Edges whose start (end, for an EdgePoint::End index) lies within `radius` (Euclidean, joint
-  // space) of q, sorted by edge id so results do not depend on the tree's traversal order. `out` is
-  // reused (no allocation once it has grown).
+  // space) of q, with their squared distances, sorted by edge id so results do not depend on
+  // the tree's shape. `out` is reused (no allocation once it has grown).
   void within(const double* q, double radius, std::vector<std::pair<uint32_t, double>>& out) const;
 
  private:

@@ -23,32 +23,28 @@ PlanningSession::PlanningSession(const std::string& bundle_path, bool memory_map
       collision(build_collision_model(scene.robot, scene.env)),
       settings(settings_from_header(bundle.header())),
       sim(scene.robot, collision, unsampled(settings.simulation)),
-      index(bundle),
-      end_index(bundle, EdgePoint::End),
+      indexes(load_bundle_indexes(bundle, memory_map)),
+      index(indexes.starts),
+      end_index(indexes.ends),
       load_seconds(std::chrono::duration<double>(Clock::now() - started_).count()) {}
 
 double bundle_theta(const BundleView& bundle) {
   return bundle.has_perturbation() ? bundle.perturbation_theta() : bundle.header().design_theta;
 }
 
-double mean_edge_displacement(const BundleView& bundle) {
-  if (bundle.size() == 0) return 0;
-  const int n = bundle.dof();
-  double sum = 0;
-  for (size_t e = 0; e < bundle.size(); ++e)
-    sum += (Eigen::Map<const Eigen::VectorXd>(bundle.qf(e), n) -
-            Eigen::Map<const Eigen::VectorXd>(bundle.q0(e), n))
-               .norm();
-  return sum / static_cast<double>(bundle.size());
+PlanningContext bundle_context(const Simulator& sim, const BundleView& bundle,
+                               const EdgeIndex& index, const EdgeIndex* end_index) {
+  return bundle_context(sim, bundle, index, end_index, mean_edge_displacement(bundle));
 }
 
 PlanningContext bundle_context(const Simulator& sim, const BundleView& bundle,
-                               const EdgeIndex& index, const EdgeIndex* end_index) {
+                               const EdgeIndex& index, const EdgeIndex* end_index,
+                               double mean_displacement) {
   const BuildSettings settings = settings_from_header(bundle.header());
   PlanningContext c{sim, &bundle, &index};
   c.end_index = end_index;
   c.theta = bundle_theta(bundle);
-  c.mean_displacement = mean_edge_displacement(bundle);
+  c.mean_displacement = mean_displacement;
   c.sample_lower = settings.region_lower;
   c.sample_upper = settings.region_upper;
   c.command = settings.command;
@@ -56,7 +52,7 @@ PlanningContext bundle_context(const Simulator& sim, const BundleView& bundle,
 }
 
 PlanningContext PlanningSession::context() const {
-  return bundle_context(sim, bundle, index, &end_index);
+  return bundle_context(sim, bundle, index, &end_index, indexes.mean_displacement);
 }
 
 double resident_memory_mib() {

@@ -1,8 +1,9 @@
 // Everything one process needs to plan on a bundle, built once and read-only afterwards (the
 // Pinocchio "model" side; each thread brings its own SimulatorWorkspace): the bundle (memory-
 // mapped, or read), its robot and environment (checked against the identity stored in the
-// bundle), the collision model, one simulator with the bundle's settings, and the k-d tree
-// over the edge starts. Shared by lazyboe-query and lazyboe-bench.
+// bundle), the collision model, one simulator with the bundle's settings, and the k-d trees
+// over the edge starts and ends (mapped from the bundle's index file, or built). Shared by
+// lazyboe-query, lazyboe-bench and the Python module.
 #pragma once
 
 #include <chrono>
@@ -12,6 +13,7 @@
 #include "lazyboe/bundle/scene.h"
 #include "lazyboe/bundle/settings.h"
 #include "lazyboe/collision/collision_model.h"
+#include "lazyboe/planning/edge_index_file.h"
 #include "lazyboe/planning/neighbour_index.h"
 #include "lazyboe/planning/planner.h"
 
@@ -20,14 +22,15 @@ namespace lazyboe {
 // theta of the bundle's perturbation analysis, or its design theta without one.
 double bundle_theta(const BundleView& bundle);
 
-// Mean joint-space displacement |qf - q0| of the bundle's edges, rad (0 for an empty bundle).
-double mean_edge_displacement(const BundleView& bundle);
-
 // The planning context of a bundle, for any holder of one (a session, a test, a front end):
 // the simulator, the bundle and its indexes, its mean edge displacement, and from the bundle's
 // header its theta, sampling box and command family.
 PlanningContext bundle_context(const Simulator& sim, const BundleView& bundle,
                                const EdgeIndex& index, const EdgeIndex* end_index = nullptr);
+// The same with the mean edge displacement known (it reads every edge state to compute).
+PlanningContext bundle_context(const Simulator& sim, const BundleView& bundle,
+                               const EdgeIndex& index, const EdgeIndex* end_index,
+                               double mean_displacement);
 
 class PlanningSession {
  public:
@@ -47,8 +50,9 @@ class PlanningSession {
   const CollisionModel collision;
   const BuildSettings settings;  // the bundle's simulation, command and region settings
   const Simulator sim;           // trajectories are not sampled (sample_every = 0)
-  const EdgeIndex index;         // edge start states: the planners' neighbourhoods
-  const EdgeIndex end_index;     // edge end states: goal coverage
+  const BundleIndexes indexes;   // where they come from: indexes.source
+  const EdgeIndex& index;        // edge start states: the planners' neighbourhoods
+  const EdgeIndex& end_index;    // edge end states: goal coverage
   const double load_seconds;     // wall time of everything above
 
   // bundle_context of the session's simulator, bundle and indexes.

@@ -107,6 +107,7 @@ class PlanningSession:
     robot: Robot
     bundle: Bundle
     load_seconds: float
+    index_source: str
     default_theta: float
     def __init__(self, bundle_path: Path, memory_map: bool = True, robot: Optional[Path] = None,
                  env: Optional[Path] = None) -> None: ...

@@ -9,6 +9,7 @@
 #include "convert.h"
 #include "lazyboe/bundle/bundle_view.h"
 #include "lazyboe/bundle/inspect.h"
+#include "lazyboe/planning/edge_index_file.h"
 
 namespace lazyboe::python {
 
@@ -171,11 +172,16 @@ void bind_bundle(py::module_& m) {
           [](const BundleView& v) {
             const std::string path = v.path();
             py::gil_scoped_release free;
-            return file_errors(
-                [&] { return printed([&](std::FILE* out) { print_inspection(path, out); }); });
+            return file_errors([&] {
+              return printed([&](std::FILE* out) {
+                print_inspection(path, out);
+                print_files_beside(path, out);
+              });
+            });
           },
           "The text of `lazyboe-build --inspect`: header and statistics (durations, "
-          "displacements, coverage, neighbours within theta).")
+          "displacements, coverage, neighbours within theta; the k-d tree index and checkpoint "
+          "journals beside the file).")
       .def("__repr__", [](const BundleView& v) {
         return "<lazyboe.Bundle '" + v.path() + "': " + std::to_string(v.size()) + " edges>";
       });

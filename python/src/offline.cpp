@@ -12,10 +12,12 @@
 #include "lazyboe/bundle/builder.h"
 #include "lazyboe/bundle/bundle_file.h"
 #include "lazyboe/bundle/bundle_view.h"
+#include "lazyboe/bundle/checkpoint_journal.h"
 #include "lazyboe/bundle/perturbation.h"
 #include "lazyboe/bundle/scene.h"
 #include "lazyboe/bundle/settings.h"
 #include "lazyboe/common/version.h"
+#include "lazyboe/planning/edge_index_file.h"
 
 namespace lazyboe::python {
 namespace {
@@ -121,6 +123,17 @@ BuildSettings build_settings(const BuildArgs& a, const BundleHeader* resumed) {
   return s;
 }
 
+// As lazyboe-build: the finished bundle gets its k-d tree index; failing that is a warning.
+void write_index_or_warn(const std::string& path) {
+  try {
+    write_bundle_index(BundleView::open(path));
+  } catch (const Error& e) {
+    const std::string message =
+        std::string(e.what()) + "; planning will build the k-d trees at load";
+    if (PyErr_WarnEx(PyExc_RuntimeWarning, message.c_str(), 1) < 0) throw py::error_already_set();
+  }
+}
+
 // lazyboe-build --resume's preparation of the file; false when it is complete already.
 bool prepare_resume(Bundle& existing, const BuildSettings& s) {
   if (existing.size() > s.edges)
@@ -155,9 +168,12 @@ py::object build(const py::object& out_arg, const py::object& robot_arg, const p
   if (!(checkpoint_seconds >= 0)) throw InputError("checkpoint_seconds: must be >= 0");
   const bool exists = std::filesystem::exists(out);
   Bundle existing;
+  BuildCheckpoints checkpoints(out);
   if (resume) {
     if (!exists) throw FileError(out + ": cannot resume: no such file");
-    existing = file_errors([&] { return read_bundle(out); });
+    JournalReplay replay;
+    existing = file_errors([&] { return checkpoints.load(&replay); });
+    if (!quiet && !replay.note.empty()) std::fprintf(stderr, "lazyboe: %s\n", replay.note.c_str());
   } else if (exists && !force) {
     throw FileError(
         out + ": already exists (use force=True to overwrite, or resume=True to continue it)");
@@ -194,8 +210,11 @@ py::object build(const py::object& out_arg, const py::object& robot_arg, const p
   control.quiet = quiet;
   control.stop_requested = [&] { return py_control.stop_requested(); };
   control.progress = [&](uint64_t done, uint64_t total) { py_control.report(done, total); };
-  control.save_checkpoint = [&](const Bundle& b) { write_bundle(out, b); };
+  control.save_progress = [&](const Bundle& b, bool last) {
+    last ? checkpoints.finish(b) : checkpoints.save(b);
+  };
   run_job(py_control, [&] { build_bundle(sim, s, bundle, control); });
+  write_index_or_warn(out);
   return open_bundle(out);
 }
 
@@ -225,8 +244,11 @@ py::object perturb(const py::object& path_arg, const py::object& theta_arg, uint
   options.sample_every = 0;
   const Simulator sim(scene.robot, collision, options);
   input_errors([&] { prepare_perturbation(bundle, s, replace, path); });
-  if (bundle.perturbation.complete) {
-    write_bundle(path, bundle);  // p may have been raised to an equal value: keep in sync
+  PerturbCheckpoints checkpoints(path);
+  const JournalReplay replay = file_errors([&] { return checkpoints.resume(bundle, s); });
+  if (!quiet && !replay.note.empty()) std::fprintf(stderr, "lazyboe: %s\n", replay.note.c_str());
+  if (bundle.perturbation.complete && !replay.applied) {
+    checkpoints.finish(bundle);  // p may have been raised to an equal value: keep in sync
     return open_bundle(path);
   }
   PythonControl py_control{progress, nullptr};
@@ -236,7 +258,9 @@ py::object perturb(const py::object& path_arg, const py::object& theta_arg, uint
   control.quiet = quiet;
   control.stop_requested = [&] { return py_control.stop_requested(); };
   control.progress = [&](uint64_t done, uint64_t total) { py_control.report(done, total); };
-  control.save_checkpoint = [&](const Bundle& b) { write_bundle(path, b); };
+  control.save_progress = [&](const Bundle& b, const std::vector<size_t>& edges, bool last) {
+    last ? checkpoints.finish(b) : checkpoints.save(b, edges);
+  };
   run_job(py_control, [&] { run_perturbation(sim, bundle, s, control); });
   return open_bundle(path);
 }

@@ -1,6 +1,7 @@
 """build_bundle / perturb_bundle: the tools' bundles, a progress callback, and a clean stop
 (Ctrl-C or an exception in the callback) that leaves a resumable file."""
 
+import pathlib
 import signal
 import subprocess
 import sys
@@ -32,6 +33,9 @@ def test_build_and_perturb_equal_the_tools(tmp_path, bundle_path):
     tools = lazyboe.Bundle(bundle_path)
     assert_same(b, tools, DATASETS)
     assert calls[-1] == (EDGES, EDGES) and all(t == EDGES for _, t in calls)
+    index = tmp_path / "b.h5.kd-index"  # written as lazyboe-build writes it, and used
+    assert index.read_bytes() == pathlib.Path(str(bundle_path) + ".kd-index").read_bytes()
+    assert lazyboe.PlanningSession(tmp_path / "b.h5").index_source == f"mapped from {index}"
     assert [d for d, _ in calls] == sorted(d for d, _ in calls)
 
     calls.clear()

@@ -1,0 +1,241 @@
+#include "lazyboe/planning/edge_index_file.h"
+
+#include <fcntl.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <Eigen/Core>
+#include <cerrno>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+
+#include "lazyboe/bundle/bundle_file.h"
+#include "lazyboe/bundle/checkpoint_journal.h"
+#include "lazyboe/common/atomic_file.h"
+#include "lazyboe/common/error.h"
+#include "lazyboe/common/hash.h"
+
+namespace lazyboe {
+
+namespace {
+
+constexpr char kMagic[8] = {'L', 'B', 'K', 'D', 'I', 'D', 'X', '\n'};
+constexpr uint32_t kVersion = 1;
+constexpr size_t kHeaderBytes = 128;
+
+// The fixed header (little-endian, as the bundle's datasets); the body follows at byte 128.
+struct IndexHeader {
+  char magic[8];
+  uint32_t version, dof;
+  uint64_t edges;
+  uint32_t leaf_size, reserved;
+  char states_checksum[64];  // BundleView::states_checksum(), NUL-padded
+  double mean_displacement;
+  uint64_t node_count[2];  // the start tree's, the end tree's
+  uint64_t body_checksum;  // FNV-1a 64 of the body
+};
+static_assert(sizeof(IndexHeader) == kHeaderBytes, "IndexHeader is a file format");
+
+size_t padded8(size_t bytes) { return (bytes + 7) / 8 * 8; }
+
+// One tree's part of the body: the box (2 x dof doubles), the order (edges ids, padded to 8
+// bytes), the nodes.
+size_t tree_bytes(uint64_t edges, int dof, uint64_t nodes) {
+  return 2 * sizeof(double) * static_cast<size_t>(dof) + padded8(edges * sizeof(uint32_t)) +
+         nodes * sizeof(KdNode);
+}
+
+void append(std::string& out, const void* data, size_t bytes) {
+  out.append(static_cast<const char*>(data), bytes);
+}
+
+void append_tree(std::string& body, const KdTreeArrays& t, uint64_t edges, int dof) {
+  append(body, t.lower, sizeof(double) * static_cast<size_t>(dof));
+  append(body, t.upper, sizeof(double) * static_cast<size_t>(dof));
+  append(body, t.order, edges * sizeof(uint32_t));
+  body.resize(padded8(body.size()), '\0');
+  append(body, t.nodes, t.node_count * sizeof(KdNode));
+}
+
+// The arrays of one tree at `p` in the body (sizes checked by the caller).
+KdTreeArrays tree_at(const char* p, uint64_t edges, int dof, uint64_t nodes) {
+  KdTreeArrays t;
+  t.lower = reinterpret_cast<const double*>(p);
+  t.upper = t.lower + dof;
+  t.order = reinterpret_cast<const uint32_t*>(p + 2 * sizeof(double) * static_cast<size_t>(dof));
+  t.nodes = reinterpret_cast<const KdNode*>(p + 2 * sizeof(double) * static_cast<size_t>(dof) +
+                                            padded8(edges * sizeof(uint32_t)));
+  t.node_count = nodes;
+  return t;
+}
+
+struct FileBytes {
+  std::shared_ptr<const void> storage;
+  const char* data = nullptr;
+  size_t size = 0;
+};
+
+// The whole file, mapped read-only or read. Throws Error naming it when it cannot be.
+FileBytes file_bytes(const std::string& path, bool memory_map) {
+  FileBytes f;
+  if (!memory_map) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) fail(path, std::string("cannot open: ") + std::strerror(errno));
+    auto bytes = std::make_shared<std::string>(std::istreambuf_iterator<char>(in),
+                                               std::istreambuf_iterator<char>());
+    f.data = bytes->data();
+    f.size = bytes->size();
+    f.storage = std::move(bytes);
+    return f;
+  }
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) fail(path, std::string("cannot open: ") + std::strerror(errno));
+  struct stat st {};
+  void* map = MAP_FAILED;
+  if (::fstat(fd, &st) == 0 && st.st_size > 0)
+    map = ::mmap(nullptr, static_cast<size_t>(st.st_size), PROT_READ, MAP_SHARED, fd, 0);
+  ::close(fd);  // the mapping stays valid
+  if (map == MAP_FAILED) fail(path, "cannot memory-map (empty or unreadable)");
+  f.size = static_cast<size_t>(st.st_size);
+  f.storage = std::shared_ptr<const void>(map, FileUnmap{f.size});
+  f.data = static_cast<const char*>(map);
+  return f;
+}
+
+// What ties an index to the bundle's edge states: the checksums stored with q0 and qf, or for a
+// file written before checksums the same FNV-1a 64 computed from their bytes (one pass over them).
+std::string states_fingerprint(const BundleView& bundle) {
+  if (!bundle.states_checksum().empty()) return bundle.states_checksum();
+  const size_t bytes = bundle.size() * static_cast<size_t>(bundle.dof()) * sizeof(double);
+  std::string out;
+  for (const double* rows :
+       {bundle.size() ? bundle.q0(0) : nullptr, bundle.size() ? bundle.qf(0) : nullptr}) {
+    Fnv1a64 hash;
+    hash.update(rows, rows ? bytes : 0);
+    out += (out.empty() ? "" : " ") + std::string(kChecksumPrefix) + hash.hex();
+  }
+  return out;
+}
+
+// Why the header does not describe an index of `bundle` in a file of `size` bytes; "" if it does.
+std::string mismatch(const IndexHeader& h, const BundleView& bundle, size_t size) {
+  if (std::memcmp(h.magic, kMagic, sizeof kMagic) != 0) return "not a k-d tree index";
+  if (h.version != kVersion) return "index format version " + std::to_string(h.version);
+  const std::string stored(h.states_checksum, strnlen(h.states_checksum, sizeof h.states_checksum));
+  if (h.dof != static_cast<uint32_t>(bundle.dof()) || h.edges != bundle.size() ||
+      stored != states_fingerprint(bundle))
+    return "made for other edge states than the bundle's (rewrite it with lazyboe-build --index)";
+  const uint64_t limit = 2 * h.edges + 1;  // what check_tree accepts
+  if (h.node_count[0] > limit || h.node_count[1] > limit ||
+      size != kHeaderBytes + tree_bytes(h.edges, bundle.dof(), h.node_count[0]) +
+                  tree_bytes(h.edges, bundle.dof(), h.node_count[1]))
+    return "truncated or malformed";
+  return "";
+}
+
+// The index at `path` for `bundle`; throws Error saying why it cannot be used.
+BundleIndexes open_index(const BundleView& bundle, const std::string& path, bool memory_map) {
+  const FileBytes f = file_bytes(path, memory_map);
+  if (f.size < kHeaderBytes) fail(path, "truncated or malformed");
+  IndexHeader h;
+  std::memcpy(&h, f.data, sizeof h);
+  const std::string why = mismatch(h, bundle, f.size);
+  if (!why.empty()) fail(path, why);
+  Fnv1a64 hash;
+  hash.update(f.data + kHeaderBytes, f.size - kHeaderBytes);
+  if (hash.value() != h.body_checksum) fail(path, "checksum mismatch: the file is damaged");
+  const char* body = f.data + kHeaderBytes;
+  const KdTreeArrays starts = tree_at(body, h.edges, bundle.dof(), h.node_count[0]);
+  const KdTreeArrays ends = tree_at(body + tree_bytes(h.edges, bundle.dof(), h.node_count[0]),
+                                    h.edges, bundle.dof(), h.node_count[1]);
+  return BundleIndexes{EdgeIndex(bundle, EdgePoint::Start, starts, f.storage, path),
+                       EdgeIndex(bundle, EdgePoint::End, ends, f.storage, path),
+                       h.mean_displacement, (memory_map ? "mapped from " : "read from ") + path};
+}
+
+}  // namespace
+
+double mean_edge_displacement(const BundleView& bundle) {
+  if (bundle.size() == 0) return 0;
+  const int n = bundle.dof();
+  double sum = 0;
+  for (size_t e = 0; e < bundle.size(); ++e)
+    sum += (Eigen::Map<const Eigen::VectorXd>(bundle.qf(e), n) -
+            Eigen::Map<const Eigen::VectorXd>(bundle.q0(e), n))
+               .norm();
+  return sum / static_cast<double>(bundle.size());
+}
+
+std::string edge_index_path(const std::string& bundle_path) { return bundle_path + ".kd-index"; }
+
+BundleIndexes load_bundle_indexes(const BundleView& bundle, bool memory_map) {
+  const std::string path = edge_index_path(bundle.path());
+  std::string why = "no index file";
+  if (std::filesystem::exists(path)) {
+    try {
+      return open_index(bundle, path, memory_map);
+    } catch (const Error& e) {
+      why = e.what();
+    }
+  }
+  return BundleIndexes{EdgeIndex(bundle, EdgePoint::Start), EdgeIndex(bundle, EdgePoint::End),
+                       mean_edge_displacement(bundle), "built at load (" + why + ")"};
+}
+
+std::string bundle_index_status(const BundleView& bundle) {
+  const std::string path = edge_index_path(bundle.path());
+  if (!std::filesystem::exists(path))
+    return "none (planning builds the k-d trees at load; lazyboe-build --index " + bundle.path() +
+           " writes it)";
+  try {
+    open_index(bundle, path, true);
+    return path + " (used by planning)";
+  } catch (const Error& e) {
+    return std::string(e.what()) + " (not used: planning builds the k-d trees at load)";
+  }
+}
+
+void print_files_beside(const std::string& path, std::FILE* out) {
+  std::fprintf(out, "\nbeside it:\n");
+  if (read_bundle_header(path).complete)
+    std::fprintf(out, "  k-d tree index: %s\n",
+                 bundle_index_status(BundleView::open(path)).c_str());
+  for (const std::string& journal : {build_journal_path(path), perturb_journal_path(path)}) {
+    if (std::filesystem::exists(journal))
+      std::fprintf(
+          out, "  checkpoint journal %s: %ju bytes (a run was interrupted; resuming applies it)\n",
+          journal.c_str(), static_cast<uintmax_t>(std::filesystem::file_size(journal)));
+  }
+}
+
+void write_bundle_index(const BundleView& bundle) {
+  const std::string path = edge_index_path(bundle.path());
+  const std::string states = states_fingerprint(bundle);
+  IndexHeader h{};
+  if (states.size() >= sizeof h.states_checksum) fail(path, "unexpected checksum " + states);
+  const EdgeIndex starts(bundle, EdgePoint::Start), ends(bundle, EdgePoint::End);
+  std::memcpy(h.magic, kMagic, sizeof kMagic);
+  h.version = kVersion;
+  h.dof = static_cast<uint32_t>(bundle.dof());
+  h.edges = bundle.size();
+  h.leaf_size = EdgeIndex::kLeafSize;
+  std::memcpy(h.states_checksum, states.data(), states.size());
+  h.mean_displacement = mean_edge_displacement(bundle);
+  h.node_count[0] = starts.arrays().node_count;
+  h.node_count[1] = ends.arrays().node_count;
+  std::string image(kHeaderBytes, '\0');
+  append_tree(image, starts.arrays(), h.edges, bundle.dof());
+  append_tree(image, ends.arrays(), h.edges, bundle.dof());
+  Fnv1a64 hash;
+  hash.update(image.data() + kHeaderBytes, image.size() - kHeaderBytes);
+  h.body_checksum = hash.value();
+  std::memcpy(image.data(), &h, sizeof h);
+  AtomicFile out(path, AtomicFile::Writer::External);
+  out.write_all(image.data(), image.size());
+  out.commit();
+}
+
+}  // namespace lazyboe

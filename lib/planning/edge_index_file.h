@@ -1,0 +1,47 @@
+// The k-d trees of a bundle, stored beside it in "<bundle>.kd-index" so that a session maps them
+// instead of building them at load (1.2 s for a million edges). The index belongs to the bundle
+// whose q0 and qf datasets have the checksums it records (stored with them, or computed from
+// their bytes for a file written before checksums); any other file there (absent, of another
+// bundle, damaged) is ignored with the reason, and the trees are built as before.
+// Format: schemas/bundle.md, "k-d tree index".
+#pragma once
+
+#include <cstdio>
+#include <string>
+
+#include "lazyboe/bundle/bundle_view.h"
+#include "lazyboe/planning/neighbour_index.h"
+
+namespace lazyboe {
+
+// Mean joint-space displacement |qf - q0| of the bundle's edges, rad (0 for an empty bundle).
+double mean_edge_displacement(const BundleView& bundle);
+
+// Both trees of a bundle and its mean edge displacement (stored in the index, since computing
+// it reads every edge state).
+struct BundleIndexes {
+  EdgeIndex starts, ends;
+  double mean_displacement = 0;
+  std::string source;  // "mapped from PATH", or "built at load" and why
+};
+
+std::string edge_index_path(const std::string& bundle_path);
+
+// The index file beside the bundle (memory-mapped, or read when memory_map is false) when it
+// belongs to it; the trees built otherwise.
+BundleIndexes load_bundle_indexes(const BundleView& bundle, bool memory_map);
+
+// One line on the index beside the bundle: its path and whether planning uses it (checked as a
+// session checks it), or why not.
+std::string bundle_index_status(const BundleView& bundle);
+
+// The end of --inspect (and of the Python module's inspect()): the files beside the bundle at
+// `path`, its k-d tree index and any checkpoint journal.
+void print_files_beside(const std::string& path, std::FILE* out);
+
+// Builds both trees of the bundle and writes them to edge_index_path(bundle.path()), atomically
+// (a temporary file renamed into place). Throws Error naming the index path when it cannot be
+// written.
+void write_bundle_index(const BundleView& bundle);
+
+}  // namespace lazyboe
