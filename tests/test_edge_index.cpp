@@ -182,6 +182,8 @@ TEST(EdgeIndexFile, AMalformedTreeWithAValidChecksumIsNotUsed) {
   const BundleView v = BundleView::open(path);
   write_bytes(index_path, patched(root + 16, 0));  // the root's left child: itself
   expect_built(v, "malformed k-d tree: child link");
+  write_bytes(index_path, patched(root + 20, 1));  // the root's right child: its left one
+  expect_built(v, "malformed k-d tree: a node with two parents");
   write_bytes(index_path, patched(root + 24, 9));  // split dimension 9 of 7
   expect_built(v, "malformed k-d tree: split");
   uint32_t second_id = 0;

@@ -7,6 +7,7 @@
 
 #include <Eigen/Core>
 #include <cerrno>
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -129,7 +130,8 @@ std::string mismatch(const IndexHeader& h, const BundleView& bundle, size_t size
       stored != states_fingerprint(bundle))
     return "made for other edge states than the bundle's (rewrite it with lazyboe-build --index)";
   const uint64_t limit = 2 * h.edges + 1;  // what check_tree accepts
-  if (h.node_count[0] > limit || h.node_count[1] > limit ||
+  if (h.node_count[0] > limit || h.node_count[1] > limit || !std::isfinite(h.mean_displacement) ||
+      h.mean_displacement < 0 ||
       size != kHeaderBytes + tree_bytes(h.edges, bundle.dof(), h.node_count[0]) +
                   tree_bytes(h.edges, bundle.dof(), h.node_count[1]))
     return "truncated or malformed";

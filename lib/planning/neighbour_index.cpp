@@ -151,22 +151,28 @@ struct Search {
 };
 
 // Walks the tree once: every node reached once from the root, children after their parent,
-// leaves covering order[] in sequence, depth bounded; and order[] a permutation of the ids.
+// leaves covering order[] in sequence, depth bounded; order[] a permutation of the ids, and the
+// bounding box ordered.
 void check_tree(const KdTreeArrays& t, size_t points, int dof, const std::string& where) {
   const auto bad = [&](const std::string& what) { fail(where, "malformed k-d tree: " + what); };
   if (t.node_count == 0 || t.node_count > 2 * points + 1) bad("node count");
+  for (int d = 0; d < dof; ++d)
+    if (!(t.lower[d] <= t.upper[d])) bad("bounding box");
   std::vector<bool> seen(points, false);
   for (size_t i = 0; i < points; ++i) {
     if (t.order[i] >= points || seen[t.order[i]]) bad("point order is not a permutation");
     seen[t.order[i]] = true;
   }
+  std::vector<bool> reached(t.node_count, false);
   std::vector<std::pair<uint64_t, int>> stack{{0, 0}};  // node, depth
-  uint64_t next_point = 0, reached = 0;
+  uint64_t next_point = 0, reached_count = 0;
   while (!stack.empty()) {
     const auto [index, depth] = stack.back();
     stack.pop_back();
+    if (reached[index]) bad("a node with two parents");
+    reached[index] = true;
+    ++reached_count;
     const KdNode& n = t.nodes[index];
-    ++reached;
     if (n.dim == KdNode::kLeaf) {
       if (n.first != next_point || n.second < n.first || n.second > points) bad("leaf range");
       next_point = n.second;
@@ -179,7 +185,7 @@ void check_tree(const KdTreeArrays& t, size_t points, int dof, const std::string
     stack.emplace_back(n.second, depth + 1);  // the left child is walked first
     stack.emplace_back(n.first, depth + 1);
   }
-  if (next_point != points || reached != t.node_count) bad("leaves do not cover the points");
+  if (next_point != points || reached_count != t.node_count) bad("leaves do not cover the points");
 }
 
 }  // namespace
