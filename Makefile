@@ -81,6 +81,7 @@ install: build
 
 bench: build
 	$(BUILD_DIR)/bin/bench_robot
+	$(BUILD_DIR)/bin/bench_index
 
 format:
 	clang-format -i $$(git ls-files '*.h' '*.cpp')

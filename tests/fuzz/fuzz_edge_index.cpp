@@ -1,12 +1,16 @@
 // The k-d tree index file beside a bundle (edge_index_file.h, schemas/bundle.md, "k-d tree
 // index"): whatever bytes lie at <bundle>.kd-index, a session either refuses them (and builds
 // the trees, saying why) or maps them and searches them; a search of an accepted index must
-// stay in bounds and end. The first byte chooses mapped or read; the rest is the file.
+// stay in bounds and end. The first byte chooses mapped or read (bit 0) and whether the body's
+// checksum is recomputed before the file is written (bit 1), so that mutated trees get past it
+// to the structure check and the search; the rest is the file.
+#include <cstring>
 #include <vector>
 
 #include "edge_index_bundle.h"
 #include "fuzz_util.h"
 #include "lazyboe/bundle/bundle_view.h"
+#include "lazyboe/common/hash.h"
 #include "lazyboe/planning/edge_index_file.h"
 
 using namespace lazyboe;
@@ -22,12 +26,20 @@ const BundleView& bundle_view() {
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if (size == 0) return 0;
   const BundleView& view = bundle_view();
-  fuzz::write_scratch("bundle.h5.kd-index", data + 1, size - 1);
-  const BundleIndexes indexes = load_bundle_indexes(view, data[0] % 2 == 0);
+  std::vector<uint8_t> file(data + 1, data + size);
+  constexpr size_t kHeader = 128, kChecksumAt = 120;  // schemas/bundle.md, "k-d tree index"
+  if ((data[0] & 2) && file.size() >= kHeader) {
+    Fnv1a64 hash;
+    hash.update(file.data() + kHeader, file.size() - kHeader);
+    const uint64_t value = hash.value();
+    std::memcpy(file.data() + kChecksumAt, &value, sizeof value);
+  }
+  fuzz::write_scratch("bundle.h5.kd-index", file.data(), file.size());
+  const BundleIndexes indexes = load_bundle_indexes(view, (data[0] & 1) == 0);
   std::vector<std::pair<uint32_t, double>> found;
   size_t total = 0;
-  for (size_t e = 0; e < view.size(); e += 37) {
-    for (const double radius : {0.3, 1.2, 5.0}) {
+  for (size_t e = 0; e < view.size(); e += 150) {  // a few searches: the checks are the target
+    for (const double radius : {0.3, 1.5}) {
       indexes.starts.within(view.q0(e), radius, found);
       total += found.size();
       indexes.ends.within(view.qf(e), radius, found);
