@@ -83,7 +83,6 @@ SmallBundles build_small_bundles() {
   Bundle built = new_bundle(robot, env, s);
   BuildControl build;
   build.quiet = true;
-  build.save_checkpoint = [](const Bundle&) {};  // nothing to persist
   if (build_bundle(sim, s, built, build) != BuildOutcome::Complete)
     throw std::runtime_error("the in-memory build did not complete");
 
@@ -98,7 +97,6 @@ SmallBundles build_small_bundles() {
   prepare_perturbation(perturbed, p, false, "the in-memory bundle");
   PerturbControl perturb;
   perturb.quiet = true;
-  perturb.save_checkpoint = [](const Bundle&) {};
   if (run_perturbation(perturb_sim, perturbed, p, perturb) != PerturbOutcome::Complete)
     throw std::runtime_error("the in-memory perturbation analysis did not complete");
 

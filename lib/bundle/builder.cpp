@@ -208,11 +208,7 @@ BuildOutcome build_bundle(const Simulator& sim, const BuildSettings& settings, B
   bool last = false;
   Checkpointer checkpoints(control.checkpoint_seconds, [&] {
     h.wall_seconds = wall_before + progress.elapsed();
-    if (control.save_progress) {
-      control.save_progress(bundle, last);
-    } else if (control.save_checkpoint) {
-      control.save_checkpoint(bundle);
-    }
+    if (control.save_progress) control.save_progress(bundle, last);
   });
   auto save = [&](bool complete) {
     h.complete = complete;

@@ -35,9 +35,9 @@ struct BuildControl {
   double checkpoint_seconds = 10;  // at least this long between checkpoints
   bool quiet = false;
   std::function<bool()> stop_requested;                // polled between rounds
-  std::function<void(const Bundle&)> save_checkpoint;  // persists the bundle so far
-  // Instead of save_checkpoint when set: `last` is true for the run's last save (complete, or
-  // interrupted), so that checkpoints can be incremental (checkpoint_journal.h).
+  // Persists the bundle so far (unset: nothing is saved); `last` is true for the run's last
+  // save (complete, or interrupted), so that checkpoints can be incremental
+  // (checkpoint_journal.h).
   std::function<void(const Bundle&, bool last)> save_progress;
   std::function<void(uint64_t done, uint64_t total)> progress;  // valid edges, after each round
   CheckpointStats* stats = nullptr;  // receives what the saves cost, when set

@@ -214,13 +214,10 @@ PerturbOutcome run_perturbation(const Simulator& sim, Bundle& b, const PerturbSe
   std::vector<size_t> since_save;
   Checkpointer checkpoints(control.checkpoint_seconds, [&] {
     p.wall_seconds = wall_before + progress.elapsed();
-    if (control.save_progress) {
-      since_save.assign(pending.begin() + saved, pending.begin() + applied);
-      control.save_progress(b, since_save, last);
-      saved = applied;
-    } else if (control.save_checkpoint) {
-      control.save_checkpoint(b);
-    }
+    if (!control.save_progress) return;
+    since_save.assign(pending.begin() + saved, pending.begin() + applied);
+    control.save_progress(b, since_save, last);
+    saved = applied;
   });
   auto save = [&](bool complete) {
     p.complete = complete;

@@ -33,9 +33,8 @@ struct PerturbControl {
   double checkpoint_seconds = 10;
   bool quiet = false;
   std::function<bool()> stop_requested;
-  std::function<void(const Bundle&)> save_checkpoint;
-  // Instead of save_checkpoint when set: `edges` were finished since the previous save; `last`
-  // is true for the run's last save (complete, or interrupted).
+  // Persists the analysis so far (unset: nothing is saved): `edges` were finished since the
+  // previous save; `last` is true for the run's last save (complete, or interrupted).
   std::function<void(const Bundle&, const std::vector<size_t>& edges, bool last)> save_progress;
   std::function<void(uint64_t done, uint64_t total)> progress;  // finished edges, after each round
   CheckpointStats* stats = nullptr;  // receives what the saves cost, when set
