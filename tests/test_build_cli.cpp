@@ -851,6 +851,10 @@ TEST(BuildCli, AFinishedBuildWritesTheKdTreeIndexThatPlanningMaps) {
   r = build_tool({"--index", out});
   ASSERT_EQ(r.exit_code, 0) << describe(r);
   EXPECT_TRUE(read_file(index) == written) << "--index wrote another file than the build";
+  fs::remove(index);  // a finished bundle "resumed" gets the index it lacks
+  r = build_tool({"--resume", "--out", out, "--quiet"});
+  ASSERT_EQ(r.exit_code, 0) << describe(r);
+  EXPECT_TRUE(fs::exists(index) && read_file(index) == written);
 
   const CommandResult missing = build_tool({"--index", dir + "/none.h5"});
   expect_one_line_error(missing, {dir + "/none.h5", "cannot open"});

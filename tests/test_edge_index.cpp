@@ -1,7 +1,9 @@
 // The k-d trees over the edge states (neighbour_index.h) and their index file beside the bundle
 // (edge_index_file.h): the same neighbours as a scan of every edge, built or mapped; an index
-// that does not belong to the bundle, or is damaged, is never used.
+// that does not belong to the bundle, is damaged, or is not a file is never used, and never
+// an error.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <cstring>
 #include <filesystem>
@@ -155,7 +157,24 @@ TEST(EdgeIndexFile, AnIndexOfOtherEdgesOrADamagedOneIsNotUsed) {
   write_bytes(index_path, std::string(200, 'x'));
   expect_built(BundleView::open(path), "not a k-d tree index");
   write_bytes(index_path, "");
-  expect_built(BundleView::open(path), "cannot memory-map");
+  expect_built(BundleView::open(path), "truncated or malformed");
+  std::string other_mean = good;  // the header is not under the body's checksum
+  other_mean[96] ^= 1;
+  write_bytes(index_path, other_mean);
+  expect_built(BundleView::open(path), "mean edge displacement differs from the bundle's");
+
+  // Not a file to read: never an error, never a hang.
+  fs::remove(index_path);
+  fs::create_directory(index_path);
+  expect_built(BundleView::open(path), "not a regular file");
+  fs::remove(index_path);
+  ASSERT_EQ(::mkfifo(index_path.c_str(), 0600), 0);
+  expect_built(BundleView::open(path), "not a regular file");
+  fs::remove(index_path);
+  fs::create_symlink(index_path, index_path);  // a loop
+  expect_built(BundleView::open(path), "cannot open");
+  EXPECT_NE(bundle_index_status(BundleView::open(path)).find("not used"), std::string::npos);
+  fs::remove(index_path);
 }
 
 // A file with a valid checksum but a tree that would loop or read out of bounds: refused by the
@@ -184,6 +203,11 @@ TEST(EdgeIndexFile, AMalformedTreeWithAValidChecksumIsNotUsed) {
   expect_built(v, "malformed k-d tree: child link");
   write_bytes(index_path, patched(root + 20, 1));  // the root's right child: its left one
   expect_built(v, "malformed k-d tree: a node with two parents");
+  std::string moved = good;  // the root's left side ends below its points: they lie outside
+  const double far_below = -1000;
+  std::memcpy(&moved[root], &far_below, sizeof far_below);
+  write_bytes(index_path, with_checksum(moved));
+  expect_built(v, "malformed k-d tree: a point outside its cell");
   write_bytes(index_path, patched(root + 24, 9));  // split dimension 9 of 7
   expect_built(v, "malformed k-d tree: split");
   uint32_t second_id = 0;

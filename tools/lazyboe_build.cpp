@@ -266,7 +266,7 @@ void write_index(const std::string& path, bool quiet) {
 void try_write_index(const std::string& path, bool quiet) {
   try {
     write_index(path, quiet);
-  } catch (const Error& e) {
+  } catch (const std::exception& e) {  // Error, or the file system's own
     std::fprintf(stderr,
                  "lazyboe-build: warning: %s; planning will build the k-d trees at load "
                  "(write the index later with lazyboe-build --index %s)\n",
@@ -382,7 +382,12 @@ int run(const CLI::App& app, BuildOptions& o) {
   Bundle bundle = new_bundle(robot, env, s);
   if (o.resume) {
     check_resume_compatible(existing.header, bundle.header, o.out_path);
-    if (!prepare_resume(existing, o)) return 0;
+    if (!prepare_resume(existing, o)) {  // complete already: only its index may be missing
+      std::error_code error;
+      if (!std::filesystem::exists(edge_index_path(o.out_path), error))
+        try_write_index(o.out_path, o.control.quiet);
+      return 0;
+    }
     bundle = std::move(existing);
   }
   return grow_bundle(sim, o, bundle, checkpoints);

@@ -138,9 +138,12 @@ int run_tool_on_ranks(const char* tool, bool mpi_required, int& argc, char**& ar
   const int launched = launcher_world_size();
 #ifdef LAZYBOE_HAVE_MPI
   if (launched > 0 || mpi_required) {
+    // From the start (a SIGUSR1 during the set-up must not kill a rank): rank 0 stops the job
+    // with a save at its first round; the others, once they know they are not rank 0, ignore it.
+    std::signal(SIGUSR1, lazyboe::detail::on_stop_signal);
     init(argc, argv);
     if (world().rank != 0) {
-      std::signal(SIGUSR1, SIG_IGN);  // sent to every rank; rank 0 stops the job, with a save
+      std::signal(SIGUSR1, SIG_IGN);
       try {
         serve();
       } catch (const std::exception& e) {

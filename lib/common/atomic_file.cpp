@@ -32,7 +32,9 @@ void fsync_path(const std::string& path, bool directory) {
 AtomicFile::AtomicFile(const std::string& path, Writer writer)
     : path_(path), temp_path_(path + ".tmp." + std::to_string(::getpid())) {
   // Said now, not after all the work when the rename fails.
-  if (std::filesystem::is_directory(path_)) fail(path_, "cannot write: is a directory, not a file");
+  std::error_code error;  // an unreadable path is refused by the open or the rename, clearly
+  if (std::filesystem::is_directory(path_, error))
+    fail(path_, "cannot write: is a directory, not a file");
   if (writer == Writer::External) return;
   errno = 0;
   out_.open(temp_path_, std::ios::out | std::ios::trunc);

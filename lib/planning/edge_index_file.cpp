@@ -10,8 +10,7 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
-#include <iterator>
+#include <vector>
 
 #include "lazyboe/bundle/bundle_file.h"
 #include "lazyboe/bundle/checkpoint_journal.h"
@@ -79,30 +78,38 @@ struct FileBytes {
   size_t size = 0;
 };
 
-// The whole file, mapped read-only or read. Throws Error naming it when it cannot be.
+// The whole file, mapped read-only or read. Throws Error naming it when it cannot be, or is
+// not a regular file (opened without blocking: a FIFO there must not hang the session).
 FileBytes file_bytes(const std::string& path, bool memory_map) {
-  FileBytes f;
-  if (!memory_map) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) fail(path, std::string("cannot open: ") + std::strerror(errno));
-    auto bytes = std::make_shared<std::string>(std::istreambuf_iterator<char>(in),
-                                               std::istreambuf_iterator<char>());
-    f.data = bytes->data();
-    f.size = bytes->size();
-    f.storage = std::move(bytes);
-    return f;
-  }
-  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
   if (fd < 0) fail(path, std::string("cannot open: ") + std::strerror(errno));
+  const auto refuse = [&](const std::string& why) {
+    ::close(fd);
+    fail(path, why);
+  };
   struct stat st {};
-  void* map = MAP_FAILED;
-  if (::fstat(fd, &st) == 0 && st.st_size > 0)
-    map = ::mmap(nullptr, static_cast<size_t>(st.st_size), PROT_READ, MAP_SHARED, fd, 0);
-  ::close(fd);  // the mapping stays valid
-  if (map == MAP_FAILED) fail(path, "cannot memory-map (empty or unreadable)");
+  if (::fstat(fd, &st) != 0) refuse(std::string("cannot stat: ") + std::strerror(errno));
+  if (!S_ISREG(st.st_mode)) refuse("not a regular file");
+  if (st.st_size < static_cast<off_t>(kHeaderBytes)) refuse("truncated or malformed");
+  FileBytes f;
   f.size = static_cast<size_t>(st.st_size);
-  f.storage = std::shared_ptr<const void>(map, FileUnmap{f.size});
-  f.data = static_cast<const char*>(map);
+  if (memory_map) {
+    void* map = ::mmap(nullptr, f.size, PROT_READ, MAP_SHARED, fd, 0);
+    if (map == MAP_FAILED) refuse(std::string("cannot memory-map: ") + std::strerror(errno));
+    f.storage = std::shared_ptr<const void>(map, FileUnmap{f.size});
+    f.data = static_cast<const char*>(map);
+  } else {
+    auto bytes = std::make_shared<std::string>(f.size, '\0');
+    for (size_t done = 0; done < f.size;) {
+      const ssize_t n = ::pread(fd, bytes->data() + done, f.size - done, static_cast<off_t>(done));
+      if (n <= 0 && !(n < 0 && errno == EINTR))
+        refuse(n < 0 ? std::string("cannot read: ") + std::strerror(errno) : "truncated");
+      if (n > 0) done += static_cast<size_t>(n);
+    }
+    f.data = bytes->data();
+    f.storage = std::move(bytes);
+  }
+  ::close(fd);  // a mapping stays valid
   return f;
 }
 
@@ -129,9 +136,8 @@ std::string mismatch(const IndexHeader& h, const BundleView& bundle, size_t size
   if (h.dof != static_cast<uint32_t>(bundle.dof()) || h.edges != bundle.size() ||
       stored != states_fingerprint(bundle))
     return "made for other edge states than the bundle's (rewrite it with lazyboe-build --index)";
-  const uint64_t limit = 2 * h.edges + 1;  // what check_tree accepts
-  if (h.node_count[0] > limit || h.node_count[1] > limit || !std::isfinite(h.mean_displacement) ||
-      h.mean_displacement < 0 ||
+  const uint64_t limit = 2 * h.edges + 1;  // what the tree check accepts
+  if (h.node_count[0] > limit || h.node_count[1] > limit ||
       size != kHeaderBytes + tree_bytes(h.edges, bundle.dof(), h.node_count[0]) +
                   tree_bytes(h.edges, bundle.dof(), h.node_count[1]))
     return "truncated or malformed";
@@ -141,7 +147,6 @@ std::string mismatch(const IndexHeader& h, const BundleView& bundle, size_t size
 // The index at `path` for `bundle`; throws Error saying why it cannot be used.
 BundleIndexes open_index(const BundleView& bundle, const std::string& path, bool memory_map) {
   const FileBytes f = file_bytes(path, memory_map);
-  if (f.size < kHeaderBytes) fail(path, "truncated or malformed");
   IndexHeader h;
   std::memcpy(&h, f.data, sizeof h);
   const std::string why = mismatch(h, bundle, f.size);
@@ -153,9 +158,14 @@ BundleIndexes open_index(const BundleView& bundle, const std::string& path, bool
   const KdTreeArrays starts = tree_at(body, h.edges, bundle.dof(), h.node_count[0]);
   const KdTreeArrays ends = tree_at(body + tree_bytes(h.edges, bundle.dof(), h.node_count[0]),
                                     h.edges, bundle.dof(), h.node_count[1]);
+  // Recomputed (one pass over the edge states, as the tree check makes): a stored value that
+  // differs is a damaged or foreign file, not a value to plan with.
+  const double mean = mean_edge_displacement(bundle);
+  if (std::memcmp(&mean, &h.mean_displacement, sizeof mean) != 0)
+    fail(path, "mean edge displacement differs from the bundle's");
   return BundleIndexes{EdgeIndex(bundle, EdgePoint::Start, starts, f.storage, path),
-                       EdgeIndex(bundle, EdgePoint::End, ends, f.storage, path),
-                       h.mean_displacement, (memory_map ? "mapped from " : "read from ") + path};
+                       EdgeIndex(bundle, EdgePoint::End, ends, f.storage, path), mean,
+                       (memory_map ? "mapped from " : "read from ") + path};
 }
 
 }  // namespace
@@ -176,10 +186,11 @@ std::string edge_index_path(const std::string& bundle_path) { return bundle_path
 BundleIndexes load_bundle_indexes(const BundleView& bundle, bool memory_map) {
   const std::string path = edge_index_path(bundle.path());
   std::string why = "no index file";
-  if (std::filesystem::exists(path)) {
+  std::error_code error;
+  if (std::filesystem::exists(path, error) || error) {
     try {
       return open_index(bundle, path, memory_map);
-    } catch (const Error& e) {
+    } catch (const std::exception& e) {  // any reason to ignore the file: the trees are built
       why = e.what();
     }
   }
@@ -189,28 +200,31 @@ BundleIndexes load_bundle_indexes(const BundleView& bundle, bool memory_map) {
 
 std::string bundle_index_status(const BundleView& bundle) {
   const std::string path = edge_index_path(bundle.path());
-  if (!std::filesystem::exists(path))
+  std::error_code error;
+  if (!std::filesystem::exists(path, error) && !error)
     return "none (planning builds the k-d trees at load; lazyboe-build --index " + bundle.path() +
            " writes it)";
   try {
     open_index(bundle, path, true);
     return path + " (used by planning)";
-  } catch (const Error& e) {
+  } catch (const std::exception& e) {
     return std::string(e.what()) + " (not used: planning builds the k-d trees at load)";
   }
 }
 
 void print_files_beside(const std::string& path, std::FILE* out) {
-  std::fprintf(out, "\nbeside it:\n");
+  std::vector<std::string> lines;
   if (read_bundle_header(path).complete)
-    std::fprintf(out, "  k-d tree index: %s\n",
-                 bundle_index_status(BundleView::open(path)).c_str());
+    lines.push_back("k-d tree index: " + bundle_index_status(BundleView::open(path)));
   for (const std::string& journal : {build_journal_path(path), perturb_journal_path(path)}) {
-    if (std::filesystem::exists(journal))
-      std::fprintf(
-          out, "  checkpoint journal %s: %ju bytes (a run was interrupted; resuming applies it)\n",
-          journal.c_str(), static_cast<uintmax_t>(std::filesystem::file_size(journal)));
+    std::error_code error;
+    const uintmax_t bytes = std::filesystem::file_size(journal, error);
+    if (!error)
+      lines.push_back("checkpoint journal " + journal + ": " + std::to_string(bytes) +
+                      " bytes (a run was interrupted; resuming applies it)");
   }
+  if (!lines.empty()) std::fprintf(out, "\nbeside it:\n");
+  for (const std::string& line : lines) std::fprintf(out, "  %s\n", line.c_str());
 }
 
 void write_bundle_index(const BundleView& bundle) {

@@ -150,43 +150,76 @@ struct Search {
   }
 };
 
-// Walks the tree once: every node reached once from the root, children after their parent,
-// leaves covering order[] in sequence, depth bounded; order[] a permutation of the ids, and the
-// bounding box ordered.
-void check_tree(const KdTreeArrays& t, size_t points, int dof, const std::string& where) {
-  const auto bad = [&](const std::string& what) { fail(where, "malformed k-d tree: " + what); };
-  if (t.node_count == 0 || t.node_count > 2 * points + 1) bad("node count");
-  for (int d = 0; d < dof; ++d)
-    if (!(t.lower[d] <= t.upper[d])) bad("bounding box");
-  std::vector<bool> seen(points, false);
-  for (size_t i = 0; i < points; ++i) {
-    if (t.order[i] >= points || seen[t.order[i]]) bad("point order is not a permutation");
-    seen[t.order[i]] = true;
-  }
-  std::vector<bool> reached(t.node_count, false);
-  std::vector<std::pair<uint64_t, int>> stack{{0, 0}};  // node, depth
-  uint64_t next_point = 0, reached_count = 0;
-  while (!stack.empty()) {
-    const auto [index, depth] = stack.back();
-    stack.pop_back();
-    if (reached[index]) bad("a node with two parents");
-    reached[index] = true;
-    ++reached_count;
-    const KdNode& n = t.nodes[index];
-    if (n.dim == KdNode::kLeaf) {
-      if (n.first != next_point || n.second < n.first || n.second > points) bad("leaf range");
-      next_point = n.second;
-      continue;
+// Checks a tree read from a file in one walk: every node reached once from the root, children
+// after their parent, depth bounded, leaves covering order[] in sequence, order[] a permutation
+// of the ids; and every point inside its leaf's cell (the bounding box cut by the splits above
+// it), so that searching the tree finds exactly what a scan finds.
+class TreeCheck {
+ public:
+  TreeCheck(const KdTreeArrays& t, const double* rows, size_t points, int dof, std::string where)
+      : t_(t), rows_(rows), points_(points), dof_(dof), where_(std::move(where)) {}
+
+  void run() {
+    if (t_.node_count == 0 || t_.node_count > 2 * points_ + 1) bad("node count");
+    std::vector<bool> seen(points_, false);
+    for (size_t i = 0; i < points_; ++i) {
+      if (t_.order[i] >= points_ || seen[t_.order[i]]) bad("point order is not a permutation");
+      seen[t_.order[i]] = true;
     }
-    if (n.dim >= static_cast<uint32_t>(dof) || !(n.low <= n.high)) bad("split");
-    if (n.first <= index || n.second <= index || n.first >= t.node_count ||
-        n.second >= t.node_count || depth >= kMaxDepth)
-      bad("child link");
-    stack.emplace_back(n.second, depth + 1);  // the left child is walked first
-    stack.emplace_back(n.first, depth + 1);
+    reached_.assign(t_.node_count, false);
+    std::copy(t_.lower, t_.lower + dof_, lo_.begin());
+    std::copy(t_.upper, t_.upper + dof_, hi_.begin());
+    visit(0, 0);
+    if (next_point_ != points_ || reached_count_ != t_.node_count)
+      bad("leaves do not cover the points");
   }
-  if (next_point != points || reached_count != t.node_count) bad("leaves do not cover the points");
-}
+
+ private:
+  [[noreturn]] void bad(const std::string& what) const {
+    fail(where_, "malformed k-d tree: " + what);
+  }
+
+  void leaf(const KdNode& n) {
+    if (n.first != next_point_ || n.second < n.first || n.second > points_) bad("leaf range");
+    next_point_ = n.second;
+    // The leaf's rows lie anywhere in the bundle: ask for all of them before reading one.
+    for (uint32_t i = n.first; i < n.second; ++i)
+      __builtin_prefetch(rows_ + size_t{t_.order[i]} * dof_);
+    for (uint32_t i = n.first; i < n.second; ++i) {
+      const double* p = rows_ + size_t{t_.order[i]} * dof_;
+      for (int d = 0; d < dof_; ++d)
+        if (!(p[d] >= lo_[d] && p[d] <= hi_[d])) bad("a point outside its cell");
+    }
+  }
+
+  void visit(uint64_t index, int depth) {
+    if (reached_[index]) bad("a node with two parents");
+    reached_[index] = true;
+    ++reached_count_;
+    const KdNode& n = t_.nodes[index];
+    if (n.dim == KdNode::kLeaf) return leaf(n);
+    if (n.dim >= static_cast<uint32_t>(dof_) || !(n.low <= n.high)) bad("split");
+    if (n.first <= index || n.second <= index || n.first >= t_.node_count ||
+        n.second >= t_.node_count || depth >= kMaxDepth)
+      bad("child link");
+    const double saved_hi = hi_[n.dim], saved_lo = lo_[n.dim];
+    hi_[n.dim] = std::min(saved_hi, n.low);
+    visit(n.first, depth + 1);
+    hi_[n.dim] = saved_hi;
+    lo_[n.dim] = std::max(saved_lo, n.high);
+    visit(n.second, depth + 1);
+    lo_[n.dim] = saved_lo;
+  }
+
+  const KdTreeArrays& t_;
+  const double* rows_;
+  size_t points_;
+  int dof_;
+  std::string where_;
+  std::vector<bool> reached_;
+  std::array<double, kMaxDof> lo_{}, hi_{};
+  uint64_t next_point_ = 0, reached_count_ = 0;
+};
 
 }  // namespace
 
@@ -211,7 +244,7 @@ EdgeIndex::EdgeIndex(const BundleView& bundle, EdgePoint point, const KdTreeArra
                      std::shared_ptr<const void> storage, const std::string& where)
     : impl_(std::make_unique<Impl>(
           Impl{point, point_rows(bundle, point), bundle.dof(), arrays, std::move(storage)})) {
-  check_tree(arrays, bundle.size(), bundle.dof(), where);
+  TreeCheck(arrays, impl_->rows, bundle.size(), bundle.dof(), where).run();
 }
 
 EdgeIndex::~EdgeIndex() = default;

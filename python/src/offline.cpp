@@ -127,7 +127,7 @@ BuildSettings build_settings(const BuildArgs& a, const BundleHeader* resumed) {
 void write_index_or_warn(const std::string& path) {
   try {
     write_bundle_index(BundleView::open(path));
-  } catch (const Error& e) {
+  } catch (const std::exception& e) {  // Error, or the file system's own
     const std::string message =
         std::string(e.what()) + "; planning will build the k-d trees at load";
     if (PyErr_WarnEx(PyExc_RuntimeWarning, message.c_str(), 1) < 0) throw py::error_already_set();
@@ -200,7 +200,11 @@ py::object build(const py::object& out_arg, const py::object& robot_arg, const p
   Bundle bundle = new_bundle(robot, env, s);
   if (resume) {
     input_errors([&] { check_resume_compatible(existing.header, bundle.header, out); });
-    if (!prepare_resume(existing, s)) return open_bundle(out);
+    if (!prepare_resume(existing, s)) {  // complete already: only its index may be missing
+      std::error_code error;
+      if (!std::filesystem::exists(edge_index_path(out), error)) write_index_or_warn(out);
+      return open_bundle(out);
+    }
     bundle = std::move(existing);
   }
   PythonControl py_control{progress, nullptr};

@@ -400,8 +400,8 @@ void bind_planning(py::module_& m) {
           "Wall time of opening the session, s.")
       .def_property_readonly(
           "index_source", [](const Session& s) { return s.session->indexes.source; },
-          "Where the k-d trees came from: 'mapped from <bundle>.kd-index', or 'built at load "
-          "(why)'.")
+          "Where the k-d trees came from: 'mapped from <bundle>.kd-index', 'read from ...' "
+          "(memory_map=False), or 'built at load (why)'.")
       .def_property_readonly(
           "default_theta", [](const Session& s) { return s.session->default_theta(); },
           "theta of the bundle's perturbation analysis (or its design theta).");
