@@ -9,6 +9,7 @@
 
 #include "lazyboe/bundle/bundle_view.h"
 #include "lazyboe/planning/neighbour_index.h"
+#include "states_bundle.h"
 
 namespace {
 
@@ -19,25 +20,10 @@ constexpr size_t kEdges = 100000;
 
 const BundleView& view() {
   static const BundleView v = [] {
-    auto b = std::make_shared<Bundle>();
-    b->header.complete = true;
-    b->header.dof = kDof;
-    b->header.region_lower.assign(kDof, -0.3);
-    b->header.region_upper.assign(kDof, 0.3);
-    b->knot_offset = {0};
-    b->sample_offset = {0};
     std::mt19937_64 rng(1);
     std::uniform_real_distribution<double> u(-0.3, 0.3);
-    for (size_t e = 0; e < kEdges; ++e) {
-      for (int j = 0; j < 2 * kDof; ++j) (j < kDof ? b->q0 : b->qf).push_back(u(rng));
-      b->knots.resize(b->knots.size() + 2 * kDof, 0.0);
-      b->knot_offset.push_back(b->knot_offset.back() + 2);
-      b->sample_offset.push_back(0);
-      b->duration.push_back(0.5);
-      b->command_duration.push_back(0.4);
-      b->attempt.push_back(e);
-    }
-    return BundleView::from_memory(b, "synthetic");
+    return BundleView::from_memory(
+        test::states_bundle(kEdges, kDof, -0.3, 0.3, [&] { return u(rng); }), "synthetic");
   }();
   return v;
 }

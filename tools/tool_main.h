@@ -69,9 +69,9 @@ inline CLI::Validator number_at_least_zero() {
 // SIGINT/SIGTERM handling for long jobs, and SIGUSR1 for jobs under mpirun or Slurm (mpirun
 // kills the ranks on Ctrl-C but forwards SIGUSR1 to them; `sbatch --signal` sends it before a
 // time limit). The first signal asks for a checkpoint and a clean stop (stop_requested() turns
-// true). A second one more than a second later (a user pressing
-// Ctrl-C again) ends the process at once; the last checkpoint on disk stays valid. Duplicates
-// within a second (a signal sent to the whole process group, as `timeout` does) are ignored.
+// true). A second one more than a second later (a user pressing Ctrl-C again) ends the process
+// at once; the last checkpoint on disk stays valid. Duplicates within a second (a signal sent
+// to the whole process group, as `timeout` does) are ignored.
 namespace detail {
 inline std::atomic<bool> g_stop{false};
 inline std::atomic<long> g_first_signal_ms{0};

@@ -5,9 +5,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include <Eigen/Core>
 #include <cerrno>
-#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <vector>
@@ -33,7 +31,7 @@ struct IndexHeader {
   uint64_t edges;
   uint32_t leaf_size, reserved;
   char states_checksum[64];  // BundleView::states_checksum(), NUL-padded
-  double mean_displacement;
+  uint64_t reserved2;
   uint64_t node_count[2];  // the start tree's, the end tree's
   uint64_t body_checksum;  // FNV-1a 64 of the body
 };
@@ -158,28 +156,12 @@ BundleIndexes open_index(const BundleView& bundle, const std::string& path, bool
   const KdTreeArrays starts = tree_at(body, h.edges, bundle.dof(), h.node_count[0]);
   const KdTreeArrays ends = tree_at(body + tree_bytes(h.edges, bundle.dof(), h.node_count[0]),
                                     h.edges, bundle.dof(), h.node_count[1]);
-  // Recomputed (one pass over the edge states, as the tree check makes): a stored value that
-  // differs is a damaged or foreign file, not a value to plan with.
-  const double mean = mean_edge_displacement(bundle);
-  if (std::memcmp(&mean, &h.mean_displacement, sizeof mean) != 0)
-    fail(path, "mean edge displacement differs from the bundle's");
   return BundleIndexes{EdgeIndex(bundle, EdgePoint::Start, starts, f.storage, path),
-                       EdgeIndex(bundle, EdgePoint::End, ends, f.storage, path), mean,
+                       EdgeIndex(bundle, EdgePoint::End, ends, f.storage, path),
                        (memory_map ? "mapped from " : "read from ") + path};
 }
 
 }  // namespace
-
-double mean_edge_displacement(const BundleView& bundle) {
-  if (bundle.size() == 0) return 0;
-  const int n = bundle.dof();
-  double sum = 0;
-  for (size_t e = 0; e < bundle.size(); ++e)
-    sum += (Eigen::Map<const Eigen::VectorXd>(bundle.qf(e), n) -
-            Eigen::Map<const Eigen::VectorXd>(bundle.q0(e), n))
-               .norm();
-  return sum / static_cast<double>(bundle.size());
-}
 
 std::string edge_index_path(const std::string& bundle_path) { return bundle_path + ".kd-index"; }
 
@@ -195,7 +177,7 @@ BundleIndexes load_bundle_indexes(const BundleView& bundle, bool memory_map) {
     }
   }
   return BundleIndexes{EdgeIndex(bundle, EdgePoint::Start), EdgeIndex(bundle, EdgePoint::End),
-                       mean_edge_displacement(bundle), "built at load (" + why + ")"};
+                       "built at load (" + why + ")"};
 }
 
 std::string bundle_index_status(const BundleView& bundle) {
@@ -239,7 +221,6 @@ void write_bundle_index(const BundleView& bundle) {
   h.edges = bundle.size();
   h.leaf_size = EdgeIndex::kLeafSize;
   std::memcpy(h.states_checksum, states.data(), states.size());
-  h.mean_displacement = mean_edge_displacement(bundle);
   h.node_count[0] = starts.arrays().node_count;
   h.node_count[1] = ends.arrays().node_count;
   std::string image(kHeaderBytes, '\0');

@@ -1,8 +1,9 @@
 // The k-d trees of a bundle, stored beside it in "<bundle>.kd-index" so that a session maps them
 // instead of building them at load (1.2 s for a million edges). The index belongs to the bundle
 // whose q0 and qf datasets have the checksums it records (stored with them, or computed from
-// their bytes for a file written before checksums); any other file there (absent, of another
-// bundle, damaged) is ignored with the reason, and the trees are built as before.
+// their bytes for a file written before checksums) and whose trees pass a full check against
+// the edge states; any other file there (absent, of another bundle, damaged, not a file) is
+// ignored with the reason, and the trees are built as before.
 // Format: schemas/bundle.md, "k-d tree index".
 #pragma once
 
@@ -14,15 +15,10 @@
 
 namespace lazyboe {
 
-// Mean joint-space displacement |qf - q0| of the bundle's edges, rad (0 for an empty bundle).
-double mean_edge_displacement(const BundleView& bundle);
-
-// Both trees of a bundle and its mean edge displacement (stored in the index, since computing
-// it reads every edge state).
+// Both trees of a bundle.
 struct BundleIndexes {
   EdgeIndex starts, ends;
-  double mean_displacement = 0;
-  std::string source;  // "mapped from PATH", or "built at load" and why
+  std::string source;  // "mapped from PATH", "read from PATH", or "built at load (why)"
 };
 
 std::string edge_index_path(const std::string& bundle_path);

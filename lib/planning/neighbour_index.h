@@ -47,7 +47,8 @@ class EdgeIndex {
   explicit EdgeIndex(const BundleView& bundle, EdgePoint point = EdgePoint::Start);
   // A tree read from an index file: `arrays` point into `storage`, which the index keeps alive.
   // Throws Error (naming `where`) unless the arrays form a well-shaped tree over the bundle's
-  // edges (every id once, leaves in sequence, children after parents, depth at most 64).
+  // edges (every id once, leaves in sequence, children after parents, depth at most 64) with
+  // every edge state inside its leaf's cell, so that it answers as a built tree would.
   EdgeIndex(const BundleView& bundle, EdgePoint point, const KdTreeArrays& arrays,
             std::shared_ptr<const void> storage, const std::string& where);
   ~EdgeIndex();

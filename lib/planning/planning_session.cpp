@@ -26,10 +26,22 @@ PlanningSession::PlanningSession(const std::string& bundle_path, bool memory_map
       indexes(load_bundle_indexes(bundle, memory_map)),
       index(indexes.starts),
       end_index(indexes.ends),
+      mean_displacement(mean_edge_displacement(bundle)),
       load_seconds(std::chrono::duration<double>(Clock::now() - started_).count()) {}
 
 double bundle_theta(const BundleView& bundle) {
   return bundle.has_perturbation() ? bundle.perturbation_theta() : bundle.header().design_theta;
+}
+
+double mean_edge_displacement(const BundleView& bundle) {
+  if (bundle.size() == 0) return 0;
+  const int n = bundle.dof();
+  double sum = 0;
+  for (size_t e = 0; e < bundle.size(); ++e)
+    sum += (Eigen::Map<const Eigen::VectorXd>(bundle.qf(e), n) -
+            Eigen::Map<const Eigen::VectorXd>(bundle.q0(e), n))
+               .norm();
+  return sum / static_cast<double>(bundle.size());
 }
 
 PlanningContext bundle_context(const Simulator& sim, const BundleView& bundle,
@@ -52,7 +64,7 @@ PlanningContext bundle_context(const Simulator& sim, const BundleView& bundle,
 }
 
 PlanningContext PlanningSession::context() const {
-  return bundle_context(sim, bundle, index, &end_index, indexes.mean_displacement);
+  return bundle_context(sim, bundle, index, &end_index, mean_displacement);
 }
 
 double resident_memory_mib() {

@@ -25,6 +25,9 @@ double bundle_theta(const BundleView& bundle);
 // The planning context of a bundle, for any holder of one (a session, a test, a front end):
 // the simulator, the bundle and its indexes, its mean edge displacement, and from the bundle's
 // header its theta, sampling box and command family.
+// Mean joint-space displacement |qf - q0| of the bundle's edges, rad (0 for an empty bundle).
+double mean_edge_displacement(const BundleView& bundle);
+
 PlanningContext bundle_context(const Simulator& sim, const BundleView& bundle,
                                const EdgeIndex& index, const EdgeIndex* end_index = nullptr);
 // The same with the mean edge displacement known (it reads every edge state to compute).
@@ -48,12 +51,13 @@ class PlanningSession {
   const BundleView bundle;
   const BundleScene scene;
   const CollisionModel collision;
-  const BuildSettings settings;  // the bundle's simulation, command and region settings
-  const Simulator sim;           // trajectories are not sampled (sample_every = 0)
-  const BundleIndexes indexes;   // where they come from: indexes.source
-  const EdgeIndex& index;        // edge start states: the planners' neighbourhoods
-  const EdgeIndex& end_index;    // edge end states: goal coverage
-  const double load_seconds;     // wall time of everything above
+  const BuildSettings settings;    // the bundle's simulation, command and region settings
+  const Simulator sim;             // trajectories are not sampled (sample_every = 0)
+  const BundleIndexes indexes;     // where they come from: indexes.source
+  const EdgeIndex& index;          // edge start states: the planners' neighbourhoods
+  const EdgeIndex& end_index;      // edge end states: goal coverage
+  const double mean_displacement;  // mean_edge_displacement(bundle), for context()
+  const double load_seconds;       // wall time of everything above
 
   // bundle_context of the session's simulator, bundle and indexes.
   PlanningContext context() const;

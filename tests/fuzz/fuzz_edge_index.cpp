@@ -7,18 +7,28 @@
 #include <cstring>
 #include <vector>
 
-#include "edge_index_bundle.h"
 #include "fuzz_util.h"
 #include "lazyboe/bundle/bundle_view.h"
 #include "lazyboe/common/hash.h"
 #include "lazyboe/planning/edge_index_file.h"
+#include "states_bundle.h"
 
 using namespace lazyboe;
 
 namespace {
+// 300 edges of 7 joints on a coarse grid (duplicates and shared coordinates, as real bundles
+// have), from a fixed generator: the committed seeds (tests/fuzz/corpus/edge_index) are its
+// index files.
 const BundleView& bundle_view() {
-  static const BundleView view =
-      BundleView::from_memory(fuzz::edge_index_bundle(), fuzz::scratch_dir() + "/bundle.h5");
+  static const BundleView view = [] {
+    uint64_t state = 12345;
+    const auto grid = [&] {  // a small LCG: -1, -0.75, ..., 1
+      state = state * 6364136223846793005ull + 1442695040888963407ull;
+      return static_cast<double>((state >> 33) % 9) / 4.0 - 1.0;
+    };
+    return BundleView::from_memory(test::states_bundle(300, 7, -1, 1, grid),
+                                   fuzz::scratch_dir() + "/bundle.h5");
+  }();
   return view;
 }
 }  // namespace
