@@ -309,7 +309,7 @@ void BM_RolloutPool(benchmark::State& state) {
                                        e.command_duration}};
       k = (k + 1) % edges.edges.size();
     }
-    pool.run(tasks.data(), results.data(), wave);
+    pool.run(edges.sim, tasks.data(), results.data(), wave);
     benchmark::DoNotOptimize(results.data());
   }
   state.SetItemsProcessed(state.iterations() * wave);

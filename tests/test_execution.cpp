@@ -66,7 +66,7 @@ const PathCase& long_path() {
 
 ExecutionOptions options(bool shortcut, bool blend) {
   ExecutionOptions o;
-  o.shortcut = shortcut;
+  o.shortcut_attempts = shortcut ? o.shortcut_attempts : 0;
   o.blend = blend;
   o.limits = bundle_context(fixture().sim, fixture().view, fixture().index).command;
   return o;

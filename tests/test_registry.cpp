@@ -254,9 +254,9 @@ Commands random_commands(const Simulator& sim, int count) {
 }
 
 TEST(RolloutScheduler, WithoutAPoolOfSeveralThreadsItIsOff) {
-  EXPECT_FALSE(RolloutScheduler(nullptr).enabled());
+  EXPECT_FALSE(RolloutScheduler(table().sim, nullptr).enabled());
   RolloutPool one(table().sim, 1);
-  EXPECT_FALSE(RolloutScheduler(&one).enabled());
+  EXPECT_FALSE(RolloutScheduler(table().sim, &one).enabled());
 }
 
 TEST(RolloutScheduler, GivesTheDirectResultsAndRunsOnlyWhatIsNeeded) {
@@ -267,7 +267,7 @@ TEST(RolloutScheduler, GivesTheDirectResultsAndRunsOnlyWhatIsNeeded) {
   for (int threads : {2, 3}) {
     SCOPED_TRACE(threads);
     RolloutPool pool(sim, threads);
-    RolloutScheduler s(&pool);
+    RolloutScheduler s(sim, &pool);
     ASSERT_TRUE(s.enabled());
     s.begin(7, c.profiles.size());
     EXPECT_EQ(s.node(), 7);

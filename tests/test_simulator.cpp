@@ -143,7 +143,7 @@ TEST(RolloutPool, GivesEachTaskTheSimulatorsResultInItsSlot) {
       SCOPED_TRACE(count);
       std::vector<RolloutResult> got(count);
       const size_t first = count == 24 ? 0 : 24 - count;  // the short batches: the last tasks
-      pool.run(tasks.data() + first, got.data(), count);
+      pool.run(scene.sim, tasks.data() + first, got.data(), count);
       run += count;
       EXPECT_EQ(pool.rollouts(), run);
       for (int i = 0; i < count; ++i) {

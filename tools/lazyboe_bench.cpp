@@ -126,7 +126,9 @@ void add_options(CLI::App& app, BenchOptions& o) {
                  "bundle's theta)")
       ->check(real_in({0, 1e3, true}, " rad"));
   app.add_option("--robot", o.robot_path, "Robot config (default: the bundle's)");
-  app.add_option("--env", o.env_path, "Environment (default: the bundle's)");
+  app.add_option("--env", o.env_path,
+                 "Environment the study plans in (default: the bundle's own; any scene for "
+                 "the bundle's robot)");
   app.add_flag("--resume", o.resume, "Continue an interrupted study in --out");
   app.add_flag("--force", o.force, "Overwrite the results of an earlier study in --out");
   app.add_flag("--no-figures", o.no_figures, "Do not draw the PNG figures");
@@ -196,27 +198,27 @@ std::vector<BenchProblem> study_problems(const BenchOptions& o, const StudyPaths
                                          const PlanningSession& session,
                                          const nlohmann::json& parameters, std::string& source) {
   const PlanningContext defaults = session.context();
-  SimulatorWorkspace ws(session.sim);
+  SimulatorWorkspace ws(session.sim());
   const QueryDefaults query_defaults;
   if (o.resume) {
     source = "resumed from " + paths.problems.string();
-    return read_problems(paths.problems.string(), session.sim, ws, query_defaults);
+    return read_problems(paths.problems.string(), session.sim(), ws, query_defaults);
   }
   if (o.force) {  // study.json first: its absence marks the directory as not resumable
     for (const fs::path& p : {paths.study, paths.runs, paths.partial, paths.summary}) fs::remove(p);
   }
   std::vector<BenchProblem> problems;
   if (!o.problems_file.empty()) {
-    problems = read_problems(o.problems_file, session.sim, ws, query_defaults);
+    problems = read_problems(o.problems_file, session.sim(), ws, query_defaults);
     source = "read from " + o.problems_file;
   } else {
     const double radius = o.tolerance > 0 ? o.tolerance : defaults.theta;
-    problems = sample_problems(session.sim, ws, defaults.sample_lower, defaults.sample_upper,
+    problems = sample_problems(session.sim(), ws, defaults.sample_lower, defaults.sample_upper,
                                o.problems, radius, o.seed);
     source = "drawn with seed " + std::to_string(o.seed) +
              " in the bundle's region, goal tolerance " + std::to_string(radius) + " rad";
   }
-  write_problems(paths.problems.string(), session.scene.robot, problems);
+  write_problems(paths.problems.string(), session.robot, problems);
   write_text(paths.study, parameters.dump(2) + "\n");
   return problems;
 }
@@ -285,8 +287,8 @@ StudyInfo study_info(const BenchOptions& o, const PlanningSession& session, int 
   StudyInfo info;
   info.bundle = o.bundle_path;
   info.edges = session.bundle.size();
-  info.robot = session.scene.robot.config_path;
-  info.environment = session.scene.env.path;
+  info.robot = session.robot.config_path;
+  info.environment = session.world().env.path;
   info.problems = problems;
   info.problems_source = problems_source;
   info.repeats = o.repeats;
@@ -346,9 +348,8 @@ int run(const BenchOptions& o, const std::string& command_line) {
   StudyControl control;
   control.jobs = o.jobs;
   control.stop_requested = stop_requested;
-  control.post_process = !o.raw;
-  control.execution.shortcut_attempts = o.shortcut_attempts;
-  control.execution.shortcut = o.shortcut_attempts > 0;
+  control.output.raw = o.raw;
+  control.output.shortcut_attempts = o.shortcut_attempts;
   control.on_run = [&](const RunRecord& r, size_t finished, size_t total) {
     partial.append(r, problem_ids[r.problem]);
     if (!o.quiet) print_run(r, problem_ids[r.problem], finished, total);

@@ -43,13 +43,9 @@ struct Outcome {
 // What every query of a run shares.
 struct Job {
   const PlanningSession& session;
-  PlanningContext context;
-  QueryDefaults defaults;
-  int sample_every = 1;
+  QueryDefaults defaults;  // with what to return: the flags, unless a query says otherwise
   TrajectoryOutput mode = TrajectoryOutput::None;
   std::string trajectory_dir;
-  bool raw = false;  // the planner's edge chain as it is, no post-processing
-  ExecutionOptions execution;
 };
 
 void add_options(CLI::App& app, Options& o) {
@@ -81,20 +77,23 @@ void add_options(CLI::App& app, Options& o) {
                  "none, inline (in each result) or csv (files in --trajectory-dir)")
       ->capture_default_str();
   app.add_option("--trajectory-dir", o.trajectory_dir, "Directory for --trajectories csv");
-  app.add_option("--sample-interval", o.sample_interval, "Trajectory sample spacing, s")
+  app.add_option("--sample-interval", o.sample_interval,
+                 "Trajectory sample spacing, s (a query's \"sample_interval\" overrides it)")
       ->capture_default_str()
       ->check(real_in({0, 1e3, true}, " s"));
   app.add_flag("--control-rate", o.control_rate,
                "Sample every control tick (1 kHz for the Panda): --sample-interval 0.001");
   app.add_flag("--raw", o.raw,
                "Return the planner's edge chain as it is (a stop at rest after every step), "
-               "without shortcutting and junction blending");
+               "without shortcutting and junction blending (a query's \"raw\" overrides it)");
   app.add_option("--shortcut-attempts", o.shortcut_attempts,
                  "Post-processing budget: direct commands tried per path (0: no shortcutting)")
       ->capture_default_str()
       ->check(whole_number(true));
   app.add_option("--robot", o.robot_path, "Robot config (default: the bundle's)");
-  app.add_option("--env", o.env_path, "Environment (default: the bundle's)");
+  app.add_option("--env", o.env_path,
+                 "Environment the queries are planned in (default: the bundle's own; any "
+                 "scene for the bundle's robot; a query's \"scene\" overrides it)");
   app.add_flag("--no-mmap", o.no_mmap, "Read the bundle into memory instead of mapping it");
   app.add_flag("--quiet", o.quiet, "No summary on stderr");
 }
@@ -136,29 +135,25 @@ std::pair<std::string, Outcome> answer(const Job& job, const std::string& text, 
   Outcome o;
   nlohmann::json j;
   try {
-    const Simulator& sim = job.session.sim;
-    const Query q = parse_query(text, line, sim.robot, sim, ws, job.defaults, id);
-    o.planner = q.planner;
+    const PlanningSession& session = job.session;
+    const Query q = parse_query(text, line, session.sim(), ws, job.defaults, id, &session.scenes);
+    o.planner = q.request.planner;
     if (job.mode == TrajectoryOutput::Csv && !usable_file_name(q.id)) {
       fail("line " + std::to_string(line) + ": id",
            "'" + q.id + "' cannot name a file in --trajectory-dir (no '/', not . or ..)");
     }
-    const PlanResult r = plan(job.context, ws, q.planner, q.parameters, q.problem, &pool);
-    Trajectory traj;
-    ExecutionStats exec;
-    if (r.success) {
-      traj = returned_trajectory(sim, ws, q.problem, r.best_path, job.raw, job.execution,
-                                 job.sample_every, exec);
-    }
+    const PlanningWorld& world = q.world ? *q.world : session.world();
+    const PlanAnswer a = answer_request(session.context(world), q.request, ws, &pool);
+    const PlanResult& r = a.result;
     std::string csv;
     if (r.success && job.mode == TrajectoryOutput::Csv) {
       csv = (std::filesystem::path(job.trajectory_dir) / (q.id + ".csv")).string();
-      write_trajectory_csv(csv, traj);
+      write_trajectory_csv(csv, a.trajectory);
     }
-    j = result_json(q, r, r.success ? &traj : nullptr, job.mode, csv, job.raw ? nullptr : &exec);
+    j = result_json(q, a, world, job.mode, csv);
     o.success = r.success;
     o.ttfs = r.time_to_first_solution;
-    o.cost = r.success ? traj.cost : 0;
+    o.cost = r.success ? a.trajectory.cost : 0;
   } catch (const std::exception& e) {  // Error, or anything else: never out of a job
     j = error_json(id, line, o.planner, e.what());
     o.error = true;
@@ -169,8 +164,8 @@ std::pair<std::string, Outcome> answer(const Job& job, const std::string& text, 
 // Streaming: one result per query as soon as it is ready.
 std::vector<Outcome> answer_stream(const Job& job, std::ostream& out, int sim_threads) {
   std::vector<Outcome> outcomes;
-  SimulatorWorkspace ws(job.session.sim);
-  RolloutPool pool(job.session.sim, sim_threads);
+  SimulatorWorkspace ws(job.session.sim());
+  RolloutPool pool(job.session.sim(), sim_threads);
   std::string text;
   int line = 0;
   while (std::getline(std::cin, text)) {
@@ -198,8 +193,8 @@ std::vector<Outcome> answer_file(const Job& job, const std::string& path, std::o
   std::vector<SimulatorWorkspace> workspaces;
   std::vector<std::unique_ptr<RolloutPool>> pools;  // not movable: they own threads
   for (int t = 0; t < jobs; ++t) {
-    workspaces.emplace_back(job.session.sim);
-    pools.push_back(std::make_unique<RolloutPool>(job.session.sim, sim_threads));
+    workspaces.emplace_back(job.session.sim());
+    pools.push_back(std::make_unique<RolloutPool>(job.session.sim(), sim_threads));
   }
 #pragma omp parallel for num_threads(jobs) schedule(dynamic, 1) ordered
   for (long k = 0; k < static_cast<long>(lines.size()); ++k) {
@@ -259,18 +254,15 @@ int run(const Options& o) {
   const PlanningSession session(o.bundle_path, !o.no_mmap, o.robot_path, o.env_path);
   refuse_output_as_input({"--out", o.out_path}, {{"--bundle", o.bundle_path},
                                                  {"--queries", o.queries_path},
-                                                 {"robot config", session.scene.robot.config_path},
-                                                 {"URDF", session.scene.robot.urdf_path},
-                                                 {"environment", session.scene.env.path}});
+                                                 {"robot config", session.robot.config_path},
+                                                 {"URDF", session.robot.urdf_path},
+                                                 {"environment", session.world().env.path}});
   report_load(o, session);
-  Job job{session, session.context(), QueryDefaults{}, 1, mode, o.trajectory_dir, o.raw, {}};
-  job.sample_every =
-      o.control_rate
-          ? 1
-          : std::max(1, sample_every_ticks(o.sample_interval, session.scene.robot.control_rate));
-  job.execution.limits = job.context.command;
-  job.execution.shortcut_attempts = o.shortcut_attempts;
-  job.execution.shortcut = o.shortcut_attempts > 0;
+  Job job{session, QueryDefaults{}, mode, o.trajectory_dir};
+  job.defaults.output.raw = o.raw;
+  job.defaults.output.sample_interval =
+      o.control_rate ? 1.0 / session.robot.control_rate : o.sample_interval;
+  job.defaults.output.shortcut_attempts = o.shortcut_attempts;
 
   // Output: a file written under a temporary name (renamed at the end), or standard output.
   const bool to_stdout = o.out_path == "-";

@@ -2,7 +2,7 @@
 //   plan_one_query BUNDLE START GOAL [PLANNER [TOLERANCE [BUDGET]]]
 // START and GOAL are comma-separated joint values; PLANNER a registered planner (default
 // lazyboe); TOLERANCE the joint-space goal radius in rad (default 0.3); BUDGET the planning
-// time limit in s (default 5). Prints the result and the re-validated trajectory's duration and
+// time limit in s (default 5). Prints the result and the executable trajectory's duration, stops and
 // cost; exit status 0 on success.
 #include <cstdio>
 #include <cstdlib>
@@ -14,7 +14,7 @@
 #include "lazyboe/common/numbers.h"
 #include "lazyboe/planning/planning_session.h"
 #include "lazyboe/planning/problem.h"
-#include "lazyboe/planning/registry.h"
+#include "lazyboe/planning/request.h"
 
 namespace {
 
@@ -34,11 +34,14 @@ int main(int argc, char** argv) {
     return 2;
   }
   try {
-    // The bundle (memory-mapped), its robot and environment, simulator and neighbour index.
+    // The bundle (memory-mapped), its robot and neighbour indexes, and its own scene's
+    // simulator (session.sim()).
     const lazyboe::PlanningSession session(argv[1], true, "", "");
-    lazyboe::SimulatorWorkspace ws(session.sim);  // one per thread
+    lazyboe::SimulatorWorkspace ws(session.sim());  // one per thread
 
-    lazyboe::PlanningProblem problem;
+    lazyboe::PlanRequest request;  // what every front end answers (lazyboe/planning/request.h)
+    request.planner = argc > 4 ? argv[4] : "lazyboe";
+    lazyboe::PlanningProblem& problem = request.problem;
     problem.start = joints(argv[2]);
     problem.goal.kind = lazyboe::Goal::Kind::Joint;
     problem.goal.q = joints(argv[3]);
@@ -50,21 +53,21 @@ int main(int argc, char** argv) {
             ? lazyboe::parse_real_in(argv[6], {0, lazyboe::kMaxBudgetSeconds, true}, "BUDGET", " s")
             : 5.0;
     problem.termination.stop_at_first = true;
-    lazyboe::validate_problem(session.sim, ws, problem);  // limits, collision, reach
 
-    const std::string planner = argc > 4 ? argv[4] : "lazyboe";
-    const lazyboe::PlanResult result = lazyboe::plan(session.context(), ws, planner, {}, problem);
+    // Plan, then post-process into an executable trajectory, simulated again from the exact
+    // start with every check (as lazyboe-query does; request.output.raw for the edge chain).
+    const lazyboe::PlanAnswer answer = lazyboe::answer_request(session.context(), request, ws);
+    const lazyboe::PlanResult& result = answer.result;
     if (!result.success) {
-      std::printf("%s: no solution: %s\n", planner.c_str(), result.failure.c_str());
+      std::printf("%s: no solution: %s\n", request.planner.c_str(), result.failure.c_str());
       return 1;
     }
-    // Every returned path is simulated again from the exact start with every check.
-    const lazyboe::Trajectory t =
-        lazyboe::realize_path(session.sim, ws, problem.start, result.best_path, problem.goal, 10);
+    const lazyboe::Trajectory& t = answer.trajectory;
     std::printf(
-        "%s: solved in %.3f s, %zu edges, %llu simulations; trajectory %.2f s, cost %.3f rad\n",
-        planner.c_str(), result.time_to_first_solution, result.best_path.size(),
-        static_cast<unsigned long long>(result.counters.simulations), t.duration, t.cost);
+        "%s: solved in %.3f s, %zu edges, %llu simulations; trajectory %.2f s, %d stops, cost "
+        "%.3f rad\n",
+        request.planner.c_str(), result.time_to_first_solution, result.best_path.size(),
+        static_cast<unsigned long long>(result.counters.simulations), t.duration, t.stops, t.cost);
     return 0;
   } catch (const lazyboe::Error& e) {
     std::fprintf(stderr, "plan_one_query: error: %s\n", e.what());

@@ -57,11 +57,11 @@ std::vector<BenchProblem> read_problems(const std::string& path, const Simulator
   for (int line = 1; std::getline(in, text); ++line) {
     if (text.find_first_not_of(" \t\r") == std::string::npos) continue;
     try {
-      const Query q = parse_query(text, line, sim.robot, sim, ws, defaults, id);
+      const Query q = parse_query(text, line, sim, ws, defaults, id);
       for (const BenchProblem& other : problems) {
         if (other.id == q.id) fail("line " + std::to_string(line), "id: '" + q.id + "' repeated");
       }
-      problems.push_back({q.id, q.problem.start, q.problem.goal});
+      problems.push_back({q.id, q.request.problem.start, q.request.problem.goal});
     } catch (const Error& e) {
       fail(path, e.what());
     }

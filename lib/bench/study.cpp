@@ -101,25 +101,26 @@ void check_planner_specs(const PlanningContext& context, std::vector<PlannerSpec
 
 namespace {
 
-void record_execution(const PlanningContext& context, SimulatorWorkspace& ws,
-                      const PlanningProblem& p, const PlanResult& result,
-                      const ExecutionOptions& options, RunRecord& r) {
-  ExecutionOptions o = options;
-  o.limits = context.command;
-  const ExecutableTrajectory e =
-      make_executable(context.sim, ws, p.start, result.best_path, p.goal, o, 1000);
-  // The raw chain's figures come from the stage's own re-simulation of it (the same
-  // simulations as realize_path's, so the same cost to the last bit).
-  r.best_cost = e.stats.raw_cost;
-  r.raw_duration = e.stats.raw_duration;
-  r.raw_stops = e.stats.raw_stops;
-  r.duration = e.trajectory.duration;
-  r.stops = e.trajectory.stops;
-  r.arc_length = e.trajectory.cost;
-  r.post_seconds = e.stats.seconds - e.stats.raw_seconds;
-  r.junctions = e.stats.junctions;
-  r.blends_kept = e.stats.blends_kept;
-  r.shortcuts = e.stats.shortcuts;
+// The returned trajectory's figures; the raw chain's come from the post-processing's own
+// re-simulation of it (the same simulations as realize_path's, so the same cost to the bit).
+void record_trajectory(const PlanAnswer& a, RunRecord& r) {
+  r.duration = a.trajectory.duration;
+  r.stops = a.trajectory.stops;
+  r.arc_length = a.trajectory.cost;
+  if (a.raw) {
+    r.best_cost = a.trajectory.cost;
+    r.raw_duration = a.trajectory.duration;
+    r.raw_stops = a.trajectory.stops;
+    return;
+  }
+  const ExecutionStats& e = a.execution;
+  r.best_cost = e.raw_cost;
+  r.raw_duration = e.raw_duration;
+  r.raw_stops = e.raw_stops;
+  r.post_seconds = e.seconds - e.raw_seconds;
+  r.junctions = e.junctions;
+  r.blends_kept = e.blends_kept;
+  r.shortcuts = e.shortcuts;
 }
 
 }  // namespace
@@ -131,45 +132,34 @@ uint64_t run_seed(uint64_t study_seed, int problem, int repeat) {
 
 RunRecord run_planner(const PlanningContext& context, SimulatorWorkspace& ws,
                       const PlannerSpec& planner, const BenchProblem& problem, int problem_index,
-                      int repeat, uint64_t seed, double budget, const ExecutionOptions* execution) {
+                      int repeat, uint64_t seed, double budget, const ReturnOptions& output) {
   RunRecord r;
   r.planner = planner.name;
   r.problem = problem_index;
   r.repeat = repeat;
   r.seed = seed;
   r.budget = budget;
-  PlanningProblem p;
-  p.start = problem.start;
-  p.goal = problem.goal;
-  p.termination.budget = budget;
-  p.seed = seed;
+  PlanRequest request{planner.planner, planner.parameters, {}, output};
+  request.problem.start = problem.start;
+  request.problem.goal = problem.goal;
+  request.problem.termination.budget = budget;
+  request.problem.seed = seed;
+  PlanAnswer a;
   try {
-    const PlanResult result = plan(context, ws, planner.planner, planner.parameters, p);
-    r.counters = result.counters;
-    r.n_solutions = result.n_solutions;
-    if (!result.success) {
-      r.failure = result.failure;
-      return r;
-    }
-    try {
-      if (execution) {
-        record_execution(context, ws, p, result, *execution, r);
-      } else {
-        const Trajectory t = realize_path(context.sim, ws, p.start, result.best_path, p.goal, 1000);
-        r.best_cost = r.arc_length = t.cost;
-        r.raw_duration = r.duration = t.duration;
-        r.raw_stops = r.stops = t.stops;
-      }
-    } catch (const Error&) {
-      r.n_solutions = 0;  // the path failed the re-check: it is not a solution
-      throw;
-    }
-    r.success = true;
-    r.time_to_first_solution = result.time_to_first_solution;
+    a = answer_request(context, request, ws);
   } catch (const std::exception& e) {  // nothing may leave a run (an OpenMP region)
-    r.success = false;
-    r.failure = std::string("error: ") + e.what();
+    r.failure = std::string("error: ") + e.what();  // a path that failed its re-check, too
+    return r;
   }
+  r.counters = a.result.counters;
+  r.n_solutions = a.result.n_solutions;
+  if (!a.result.success) {
+    r.failure = a.result.failure;
+    return r;
+  }
+  record_trajectory(a, r);
+  r.success = true;
+  r.time_to_first_solution = a.result.time_to_first_solution;
   return r;
 }
 
@@ -193,7 +183,7 @@ std::vector<RunRecord> run_study(const PlanningContext& context,
     RunRecord r = run_planner(context, workspaces[omp_get_thread_num()], planners[task.planner],
                               problems[task.problem], task.problem, task.repeat,
                               run_seed(study_seed, task.problem, task.repeat), budget,
-                              control.post_process ? &control.execution : nullptr);
+                              control.output);
 #pragma omp critical(lazyboe_study_finished)
     {
       ++finished;

@@ -9,6 +9,7 @@
 
 #include "lazyboe/bench/problems.h"
 #include "lazyboe/planning/execution.h"
+#include "lazyboe/planning/request.h"
 #include "lazyboe/planning/parameters.h"
 
 namespace lazyboe {
@@ -62,16 +63,19 @@ struct RunRecord {
 // The seed of a (problem, repeat) run: the same for every planner, different across repeats.
 uint64_t run_seed(uint64_t study_seed, int problem, int repeat);
 
-// One run. The best path is re-simulated from the exact start with every check
-// (realize_path, or make_executable's raw pass); its cost is the reported cost (the planner's
-// path, as the paper reports it), and a path that fails the check is reported as a failed run
-// with the reason (it would be a planner bug). With `execution`, the path is also post-processed
-// (make_executable, after the planner's clock has stopped) and the record gets the executed
-// trajectory's figures.
+// Trajectory sampling of a study's runs: only the returned trajectory's figures are kept, not
+// its samples (1000 control ticks at the Panda's 1 kHz).
+constexpr double kStudySampleInterval = 1.0;  // s
+
+// One run, answered as every front end answers a request (answer_request, request.h). The
+// best path is re-simulated from the exact start with every check (realize_path, or
+// make_executable's raw pass); its cost is the reported cost (the planner's path, as the paper
+// reports it), and a path that fails the check is reported as a failed run with the reason (it
+// would be a planner bug). Unless `output.raw`, the path is also post-processed (after the
+// planner's clock has stopped) and the record gets the executed trajectory's figures.
 RunRecord run_planner(const PlanningContext& context, SimulatorWorkspace& ws,
                       const PlannerSpec& planner, const BenchProblem& problem, int problem_index,
-                      int repeat, uint64_t seed, double budget,
-                      const ExecutionOptions* execution = nullptr);
+                      int repeat, uint64_t seed, double budget, const ReturnOptions& output);
 
 struct StudyTask {
   int planner = 0;  // index into the specs
@@ -84,8 +88,8 @@ struct StudyControl {
   std::function<bool()> stop_requested;  // polled before each run starts
   // Called for each finished run, one at a time (under a lock), in completion order.
   std::function<void(const RunRecord&, size_t finished, size_t total)> on_run;
-  bool post_process = true;  // run_planner's `execution`: post-process every returned path
-  ExecutionOptions execution;
+  // What run_planner returns: post-processed (raw = false) by default.
+  ReturnOptions output{false, kStudySampleInterval, ExecutionOptions{}.shortcut_attempts};
 };
 
 // Runs `tasks`; returns the records of the runs that finished, in task order. Runs in progress

@@ -28,27 +28,37 @@ void require_recorded_file(const std::string& path, const char* what, const char
 
 }  // namespace
 
-BundleScene load_bundle_scene(const BundleHeader& h, std::string robot_path, std::string env_path) {
+RobotModel load_bundle_robot(const BundleHeader& h, std::string robot_path) {
   if (robot_path.empty()) {
     robot_path = h.robot_config;
     require_recorded_file(robot_path, "robot config", "--robot");
   }
-  if (env_path.empty()) {
-    env_path = h.env_file;
-    require_recorded_file(env_path, "environment", "--env");
-  }
-  BundleScene scene{load_robot(robot_path), load_environment(env_path)};
-  const std::string robot_hash = robot_identity(scene.robot);
+  RobotModel robot = load_robot(robot_path);
+  const std::string robot_hash = robot_identity(robot);
   if (robot_hash != h.robot_hash) {
     fail(robot_path, "is not the robot the bundle was built with (" + h.robot_config + ", hash " +
                          h.robot_hash + "; this one hashes to " + robot_hash + ")");
   }
-  const std::string env_hash = environment_identity(scene.env);
+  return robot;
+}
+
+Environment load_bundle_environment(const BundleHeader& h, std::string env_path) {
+  if (env_path.empty()) {
+    env_path = h.env_file;
+    require_recorded_file(env_path, "environment", "--env");
+  }
+  Environment env = load_environment(env_path);
+  const std::string env_hash = environment_identity(env);
   if (env_hash != h.env_hash) {
     fail(env_path, "is not the environment the bundle was built with (" + h.env_file + ", hash " +
                        h.env_hash + "; this one hashes to " + env_hash + ")");
   }
-  return scene;
+  return env;
+}
+
+BundleScene load_bundle_scene(const BundleHeader& h, std::string robot_path, std::string env_path) {
+  return BundleScene{load_bundle_robot(h, std::move(robot_path)),
+                     load_bundle_environment(h, std::move(env_path))};
 }
 
 }  // namespace lazyboe

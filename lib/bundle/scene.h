@@ -22,5 +22,9 @@ struct BundleScene {
 };
 BundleScene load_bundle_scene(const BundleHeader& header, std::string robot_path,
                               std::string env_path);
+// Its two halves: the robot (planning in another scene still needs the bundle's robot) and the
+// environment it was built in.
+RobotModel load_bundle_robot(const BundleHeader& header, std::string robot_path);
+Environment load_bundle_environment(const BundleHeader& header, std::string env_path);
 
 }  // namespace lazyboe

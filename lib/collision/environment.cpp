@@ -2,6 +2,7 @@
 
 #include <set>
 
+#include "lazyboe/common/hash.h"
 #include "lazyboe/common/json_fields.h"
 #include "lazyboe/common/numbers.h"
 
@@ -22,13 +23,18 @@ std::string default_environment_path() { return data_dir() + "/environments/tabl
 
 Environment load_environment(const std::string& path) {
   const nlohmann::json doc = load_json_file(path);
-  const JsonField root(doc, path, "");
+  return environment_from_json(JsonField(doc, path, ""), path);
+}
+
+Environment environment_from_json(const JsonField& root, const std::string& path) {
   root.allow_only({"schema_version", "name", "description", "objects"});
   if (root.at("schema_version").integer() != 1) {
     root.at("schema_version").fail("unsupported version (this build reads version 1)");
   }
   Environment env;
   env.path = path;
+  env.origin = root.path().empty() ? path : root.where();
+  env.identity = fnv1a64_hex(root.value().dump());
   env.name = root.at("name").string();
   if (root.has("description")) env.description = root.at("description").string();
   std::set<std::string> names;

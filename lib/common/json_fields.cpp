@@ -8,6 +8,7 @@
 #include "lazyboe/common/error.h"
 #include "lazyboe/common/file_checks.h"
 #include "lazyboe/common/numbers.h"
+#include "lazyboe/common/text.h"
 
 namespace lazyboe {
 
@@ -131,7 +132,7 @@ JsonField::JsonField(const nlohmann::json& value, std::string file, std::string 
     : value_(&value), file_(std::move(file)), path_(std::move(path)) {}
 
 void JsonField::fail(const std::string& what) const {
-  lazyboe::fail(file_ + (path_.empty() ? "" : ": " + path_), what);
+  lazyboe::fail(where(), what);
 }
 
 bool JsonField::has(const std::string& key) const {
@@ -142,7 +143,7 @@ JsonField JsonField::at(const std::string& key) const {
   if (!value_->is_object()) fail("expected an object");
   auto it = value_->find(key);
   const std::string child = path_.empty() ? key : path_ + "." + key;
-  if (it == value_->end()) lazyboe::fail(file_ + ": " + child, "missing required field");
+  if (it == value_->end()) lazyboe::fail(JsonField(*value_, file_, child).where(), "missing required field");
   return JsonField(*it, file_, child);
 }
 
@@ -165,7 +166,8 @@ void JsonField::allow_only(const std::vector<std::string>& keys) const {
     bool known = false;
     for (const std::string& k : keys) known = known || it.key() == k;
     if (!known) {
-      lazyboe::fail(file_ + ": " + (path_.empty() ? "" : path_ + ".") + it.key(), "unknown field");
+      const JsonField field(it.value(), file_, path_.empty() ? it.key() : path_ + "." + it.key());
+      field.fail("unknown field" + did_you_mean(it.key(), keys));
     }
   }
 }

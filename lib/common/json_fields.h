@@ -28,6 +28,11 @@ class JsonField {
   JsonField(const nlohmann::json& value, std::string file, std::string path);
 
   const std::string& path() const { return path_; }
+  // "file: path" (or the file alone at the root), as the errors start.
+  std::string where() const {
+    return path_.empty() ? file_ : file_.empty() ? path_ : file_ + ": " + path_;
+  }
+  const nlohmann::json& value() const { return *value_; }
   [[noreturn]] void fail(const std::string& what) const;
 
   bool has(const std::string& key) const;

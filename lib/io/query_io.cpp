@@ -5,6 +5,7 @@
 #include "lazyboe/common/error.h"
 #include "lazyboe/common/json_fields.h"
 #include "lazyboe/common/numbers.h"
+#include "lazyboe/common/text.h"
 #include "lazyboe/io/csv.h"
 
 namespace lazyboe {
@@ -15,12 +16,6 @@ JointVector joint_vector(const JsonField& f, int dof) {
   if (static_cast<int>(v.size()) != dof)
     f.fail("expected " + std::to_string(dof) + " joint values");
   return Eigen::Map<const Eigen::VectorXd>(v.data(), dof);
-}
-
-const ParameterSpec& any_declaration(const std::string& name) {
-  for (const PlannerInfo& info : planner_registry())
-    if (const ParameterSpec* spec = info.parameter(name)) return *spec;
-  fail(name, "no planner declares this parameter");
 }
 
 double parameter_value(const JsonField& f, const ParameterSpec& spec) {
@@ -39,25 +34,35 @@ double parameter_value(const JsonField& f, const ParameterSpec& spec) {
   }
 }
 
-// The planner and the values of its declared parameters.
-void parse_planner(const JsonField& root, Query& q) {
-  q.planner = root.has("planner") ? root.at("planner").string() : "lazyboe";
-  const PlannerInfo* found = find_planner(q.planner);
+// "theta, stop_at_first and lazy_model", or "none".
+std::string parameter_names_text(const PlannerInfo& info) {
+  std::vector<std::string> names;
+  for (const ParameterSpec& p : info.parameters) names.push_back(p.name);
+  return names.empty() ? std::string("none") : list_text(names, " and ");
+}
+
+// The planner and the values of its declared parameters. Another planner's parameter is
+// refused: it would be silently ignored.
+void parse_planner(const JsonField& root, PlanRequest& r) {
+  r.planner = root.has("planner") ? root.at("planner").string() : "lazyboe";
+  const PlannerInfo* found = find_planner(r.planner);
   if (!found) {
-    root.at("planner").fail("unknown planner '" + q.planner + "' (expected " +
-                            planner_names_text() + ")");
+    root.at("planner").fail("unknown planner '" + r.planner + "' (expected " +
+                            planner_names_text() + ")" + did_you_mean(r.planner, planner_names()));
   }
   const PlannerInfo& info = *found;
   for (const std::string& name : all_parameter_names()) {
     if (!root.has(name)) continue;
     const JsonField f = root.at(name);
-    // Another planner's parameter is checked by that planner's declaration, and ignored.
     const ParameterSpec* spec = info.parameter(name);
-    const ParameterSpec& declared = spec ? *spec : any_declaration(name);
-    const double v = parameter_value(f, declared);
-    const std::string why = declared.check(v);
+    if (!spec) {
+      f.fail("not a parameter of " + r.planner + " (its parameters: " +
+             parameter_names_text(info) + ")");
+    }
+    const double v = parameter_value(f, *spec);
+    const std::string why = spec->check(v);
     if (!why.empty()) f.fail(why);
-    if (spec) q.parameters.set(name, v);
+    r.parameters.set(name, v);
   }
 }
 
@@ -91,39 +96,81 @@ void parse_goal(const JsonField& goal, const RobotModel& robot, const QueryDefau
 // The fields a query may have: its own, and every parameter a registered planner declares.
 const std::vector<std::string>& query_fields() {
   static const std::vector<std::string> fields = [] {
-    std::vector<std::string> f = {"id",     "start", "goal",         "planner",
-                                  "budget", "seed",  "stop_at_first"};
+    std::vector<std::string> f = {"id",    "start", "goal",          "planner",
+                                  "budget", "seed", "stop_at_first", "scene",
+                                  "raw",   "sample_interval", "shortcut_attempts"};
     for (const std::string& name : all_parameter_names()) f.push_back(name);
     return f;
   }();
   return fields;
 }
 
-}  // namespace
+// What to return: the defaults (a tool's flags) unless the query sets them.
+ReturnOptions parse_output(const JsonField& root, ReturnOptions o) {
+  if (root.has("raw")) o.raw = root.at("raw").boolean();
+  if (root.has("sample_interval"))
+    o.sample_interval = root.at("sample_interval").number_in({0, 1e3, true}, " s");
+  if (root.has("shortcut_attempts")) {
+    const long n = root.at("shortcut_attempts").integer();
+    if (n < 0 || n > 1000000) root.at("shortcut_attempts").fail("must be in [0, 1000000]");
+    o.shortcut_attempts = static_cast<int>(n);
+  }
+  return o;
+}
 
-Query parse_query(const std::string& text, int line, const RobotModel& robot, const Simulator& sim,
-                  SimulatorWorkspace& ws, const QueryDefaults& d, std::string& id_out) {
-  const std::string where = "line " + std::to_string(line);
-  const nlohmann::json doc = parse_json_text(text, where, false);
-  if (!doc.is_object()) fail(where, "expected a JSON object");
-  if (doc.contains("id") && doc["id"].is_string()) id_out = doc["id"].get<std::string>();
-  const JsonField root(doc, where, "");
-  root.allow_only(query_fields());
-  Query q;
-  q.line = line;
-  q.id = root.at("id").string();
-  parse_planner(root, q);
-  PlanningProblem& p = q.problem;
+// The world of a query's "scene": an environment file's name, or an environment object.
+WorldPtr parse_scene(const JsonField& root, SceneCache* scenes) {
+  if (!root.has("scene")) return nullptr;
+  const JsonField f = root.at("scene");
+  if (!scenes) f.fail("a scene cannot be named here");
+  if (f.value().is_object()) return scenes->inline_scene(f);
+  const std::string path = f.string();
+  try {
+    return scenes->load(path);
+  } catch (const Error& e) {
+    f.fail(e.what());
+  }
+}
+
+void parse_problem(const JsonField& root, const Simulator& sim, const QueryDefaults& d,
+                   PlanningProblem& p) {
   p.termination.budget = root.has("budget")
                              ? root.at("budget").number_in({0, kMaxBudgetSeconds, true}, " s")
                              : d.budget;
   if (root.has("stop_at_first")) p.termination.stop_at_first = root.at("stop_at_first").boolean();
   p.seed = root.has("seed") ? static_cast<uint64_t>(root.at("seed").integer()) : 1;
   if (root.has("seed") && root.at("seed").integer() < 0) root.at("seed").fail("must be >= 0");
-  p.start = joint_vector(root.at("start"), robot.dof);
-  parse_goal(root.at("goal"), robot, d, p.goal);
-  const ProblemIssue issue = find_problem_issue(sim, ws, p);
-  if (issue.any()) fail(where + ": " + issue.field, issue.what);
+  p.start = joint_vector(root.at("start"), sim.robot.dof);
+  parse_goal(root.at("goal"), sim.robot, d, p.goal);
+}
+
+}  // namespace
+
+Query read_query(const nlohmann::json& doc, const std::string& where, const Simulator& sim,
+                 SimulatorWorkspace& ws, const QueryDefaults& d, SceneCache* scenes) {
+  if (!doc.is_object()) fail(where, "expected a JSON object");
+  const JsonField root(doc, where, "");
+  root.allow_only(query_fields());
+  Query q;
+  q.id = root.at("id").string();
+  parse_planner(root, q.request);
+  q.request.output = parse_output(root, d.output);
+  q.world = parse_scene(root, scenes);
+  const Simulator& in = q.world ? q.world->sim : sim;
+  parse_problem(root, in, d, q.request.problem);
+  const ProblemIssue issue = find_problem_issue(in, ws, q.request.problem);
+  if (issue.any()) fail(where.empty() ? issue.field : where + ": " + issue.field, issue.what);
+  return q;
+}
+
+Query parse_query(const std::string& text, int line, const Simulator& sim, SimulatorWorkspace& ws,
+                  const QueryDefaults& d, std::string& id_out, SceneCache* scenes) {
+  const std::string where = "line " + std::to_string(line);
+  const nlohmann::json doc = parse_json_text(text, where, false);
+  if (doc.is_object() && doc.contains("id") && doc["id"].is_string())
+    id_out = doc["id"].get<std::string>();
+  Query q = read_query(doc, where, sim, ws, d, scenes);
+  q.line = line;
   return q;
 }
 
@@ -144,49 +191,56 @@ nlohmann::json execution_json(const ExecutionStats& e) {
           {"fell_back", e.fell_back}};
 }
 
+nlohmann::json trajectory_json(const Trajectory& traj) {
+  nlohmann::json t;
+  t["t"] = traj.t;
+  t["q"] = rows_json(traj.q);
+  t["dq"] = rows_json(traj.dq);
+  if (!traj.ddq.empty()) {
+    t["ddq"] = rows_json(traj.ddq);
+    t["cmd"] = rows_json(traj.cmd);
+  }
+  return t;
+}
+
+// What the returned trajectory is: its figures, and the raw chain's beside a post-processed one.
+void add_trajectory(const PlanAnswer& a, TrajectoryOutput mode, const std::string& csv_path,
+                    nlohmann::json& j) {
+  const Trajectory& traj = a.trajectory;
+  const ExecutionStats* execution = a.raw ? nullptr : &a.execution;
+  j["duration"] = traj.duration;
+  j["stops"] = traj.stops;
+  j["raw_duration"] = execution ? execution->raw_duration : traj.duration;
+  j["raw_stops"] = execution ? execution->raw_stops : traj.stops;
+  j["raw_cost"] = execution ? execution->raw_cost : traj.cost;
+  if (execution) j["post_processing"] = execution_json(*execution);
+  j["edges"] = traj.edges;
+  if (mode == TrajectoryOutput::Inline) j["trajectory"] = trajectory_json(traj);
+  if (mode == TrajectoryOutput::Csv) j["trajectory_file"] = csv_path;
+}
+
 }  // namespace
 
-nlohmann::json result_json(const Query& q, const PlanResult& r, const Trajectory* traj,
-                           TrajectoryOutput mode, const std::string& csv_path,
-                           const ExecutionStats* execution) {
+nlohmann::json result_json(const Query& q, const PlanAnswer& a, const PlanningWorld& world,
+                           TrajectoryOutput mode, const std::string& csv_path) {
+  const PlanResult& r = a.result;
   nlohmann::json j;
   j["id"] = q.id;
   j["line"] = q.line;
-  j["planner"] = q.planner;
+  j["planner"] = q.request.planner;
   j["success"] = r.success;
   j["time_to_first_solution"] =
       r.success ? nlohmann::json(r.time_to_first_solution) : nlohmann::json(nullptr);
   j["n_solutions"] = r.n_solutions;
-  j["best_cost"] =
-      r.success ? nlohmann::json(traj ? traj->cost : r.best_cost) : nlohmann::json(nullptr);
+  j["best_cost"] = r.success ? nlohmann::json(a.trajectory.cost) : nlohmann::json(nullptr);
   j["counters"] = {{"nodes", r.counters.nodes},
                    {"simulations", r.counters.simulations},
                    {"lazy_edges", r.counters.lazy_edges},
                    {"collision_checks", r.counters.collision_checks}};
   if (!r.success) j["failure"] = r.failure;
   if (r.success && !r.found_by.empty()) j["found_by"] = r.found_by;
-  if (traj) {
-    j["duration"] = traj->duration;
-    j["stops"] = traj->stops;
-    j["raw_duration"] = execution ? execution->raw_duration : traj->duration;
-    j["raw_stops"] = execution ? execution->raw_stops : traj->stops;
-    j["raw_cost"] = execution ? execution->raw_cost : traj->cost;
-    if (execution) j["post_processing"] = execution_json(*execution);
-    j["edges"] = traj->edges;
-    if (mode == TrajectoryOutput::Inline) {
-      nlohmann::json t;
-      t["t"] = traj->t;
-      t["q"] = rows_json(traj->q);
-      t["dq"] = rows_json(traj->dq);
-      if (!traj->ddq.empty()) {
-        t["ddq"] = rows_json(traj->ddq);
-        t["cmd"] = rows_json(traj->cmd);
-      }
-      j["trajectory"] = t;
-    } else if (mode == TrajectoryOutput::Csv) {
-      j["trajectory_file"] = csv_path;
-    }
-  }
+  j["scene"] = {{"name", world.env.name}, {"hash", world.env.identity}};
+  if (r.success) add_trajectory(a, mode, csv_path, j);
   return j;
 }
 

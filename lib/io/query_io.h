@@ -9,15 +9,17 @@
 #include "lazyboe/planning/execution.h"
 #include "lazyboe/planning/problem.h"
 #include "lazyboe/planning/registry.h"
+#include "lazyboe/planning/request.h"
+#include "lazyboe/planning/scene_cache.h"
 
 namespace lazyboe {
 
 struct Query {
   std::string id;
   int line = 0;
-  std::string planner = "lazyboe";  // a name in the planner registry
-  ParameterValues parameters;       // the planner's declared parameters the query sets
-  PlanningProblem problem;
+  PlanRequest request;
+  // The scene it names ("scene": a file or an inline environment); null: the caller's default.
+  WorldPtr world;
 };
 
 // Defaults for fields a query leaves out. (Planner parameters it leaves out take the planner's
@@ -26,22 +28,29 @@ struct QueryDefaults {
   double budget = 5.0;
   double joint_tolerance = 0.1;
   double position_tolerance = 0.02;
+  ReturnOptions output;  // raw, sample_interval, shortcut_attempts (a tool's flags)
 };
 
 // Parses one line (the id first, so even a bad query can be answered by id) and validates its
-// problem (validate_problem's checks). A query may set any parameter a registered planner
-// declares; those its planner does not declare are ignored. Throws Error("line N: field:
-// what") for anything malformed, out of range, out of limits or in collision.
-Query parse_query(const std::string& text, int line, const RobotModel& robot, const Simulator& sim,
-                  SimulatorWorkspace& ws, const QueryDefaults& defaults, std::string& id_out);
+// problem (validate_problem's checks) in its world: the scene it names, resolved through
+// `scenes` (null: naming one is an error), or else `sim`'s. A query may set only parameters its
+// planner declares. Throws Error("line N: field: what") for anything malformed, out of range,
+// out of limits or in collision.
+Query parse_query(const std::string& text, int line, const Simulator& sim, SimulatorWorkspace& ws,
+                  const QueryDefaults& defaults, std::string& id_out,
+                  SceneCache* scenes = nullptr);
+// The same for a query held as JSON; `where` starts its errors ("line 3", "queries[2]"; empty:
+// the field alone).
+Query read_query(const nlohmann::json& doc, const std::string& where, const Simulator& sim,
+                 SimulatorWorkspace& ws, const QueryDefaults& defaults,
+                 SceneCache* scenes = nullptr);
 
 enum class TrajectoryOutput { None, Inline, Csv };
 
-// `execution`: the post-processing's figures when the trajectory is post-processed
-// (execution.h); null for the raw chain (--raw), whose figures are then the trajectory's own.
-nlohmann::json result_json(const Query& q, const PlanResult& r, const Trajectory* trajectory,
-                           TrajectoryOutput mode, const std::string& csv_path,
-                           const ExecutionStats* execution = nullptr);
+// The result line of an answered query planned in `world`: the trajectory inline, as a CSV
+// file's name (csv_path) or not at all, with the post-processing's figures unless it is raw.
+nlohmann::json result_json(const Query& q, const PlanAnswer& a, const PlanningWorld& world,
+                           TrajectoryOutput mode, const std::string& csv_path);
 nlohmann::json error_json(const std::string& id, int line, const std::string& planner,
                           const std::string& error);
 

@@ -448,7 +448,7 @@ ExecutableTrajectory make_executable(const Simulator& sim, SimulatorWorkspace& w
   st.raw_stops = st.raw_steps - 1;
 
   std::vector<Step> work = raw_steps(steps, raw, sim.robot.dof);
-  if (options.shortcut) work = shortcut_steps(w, raw, std::move(work), goal);
+  if (options.shortcut_attempts > 0) work = shortcut_steps(w, raw, std::move(work), goal);
   st.steps = static_cast<int>(work.size());
   st.junctions = st.steps - 1;
   std::vector<double> rows;

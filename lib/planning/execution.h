@@ -25,11 +25,10 @@
 namespace lazyboe {
 
 struct ExecutionOptions {
-  bool shortcut = true;
   bool blend = true;
   // The post-processing budget: direct commands tried by the shortcut pass (each is one
-  // simulation plus at most max_corrections). Blending needs no budget of its own: at most
-  // about three simulations per junction.
+  // simulation plus at most max_corrections; 0: no shortcut pass). Blending needs no budget of
+  // its own: at most about three simulations per junction.
   int shortcut_attempts = 12;
   int max_corrections = 2;             // re-simulations to correct a segment's end offset
   double correction_tolerance = 2e-3;  // rad (max norm): no correction below this end offset
@@ -90,7 +89,7 @@ ExecutableTrajectory make_executable(const Simulator& sim, SimulatorWorkspace& w
 // and the raw chain keep `sim`'s settle, as the planners simulated them.
 Simulator execution_simulator(const Simulator& sim);
 
-// What a front end returns for a solved problem (lazyboe-query, the Python module): the
+// What answer_request (request.h) returns for a solved problem: the
 // executable trajectory, its figures in `stats`, or with `raw` the planner's edge chain as
 // realize_path gives it (`stats` untouched).
 Trajectory returned_trajectory(const Simulator& sim, SimulatorWorkspace& ws,

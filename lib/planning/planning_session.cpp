@@ -13,16 +13,22 @@ SimulationOptions unsampled(SimulationOptions options) {
   return options;
 }
 
+WorldPtr default_world(const BundleHeader& h, const RobotModel& robot,
+                       const SimulationOptions& options, const std::string& env_path) {
+  Environment env = env_path.empty() ? load_bundle_environment(h, "") : load_environment(env_path);
+  return std::make_shared<const PlanningWorld>(robot, std::move(env), options);
+}
+
 }  // namespace
 
 PlanningSession::PlanningSession(const std::string& bundle_path, bool memory_map,
                                  const std::string& robot_path, const std::string& env_path)
     : started_(Clock::now()),
       bundle(BundleView::open(bundle_path, memory_map)),
-      scene(load_bundle_scene(bundle.header(), robot_path, env_path)),
-      collision(build_collision_model(scene.robot, scene.env)),
+      robot(load_bundle_robot(bundle.header(), robot_path)),
       settings(settings_from_header(bundle.header())),
-      sim(scene.robot, collision, unsampled(settings.simulation)),
+      scenes(robot, unsampled(settings.simulation),
+             default_world(bundle.header(), robot, unsampled(settings.simulation), env_path)),
       indexes(load_bundle_indexes(bundle, memory_map)),
       index(indexes.starts),
       end_index(indexes.ends),
@@ -63,8 +69,8 @@ PlanningContext bundle_context(const Simulator& sim, const BundleView& bundle,
   return c;
 }
 
-PlanningContext PlanningSession::context() const {
-  return bundle_context(sim, bundle, index, &end_index, mean_displacement);
+PlanningContext PlanningSession::context(const PlanningWorld& w) const {
+  return bundle_context(w.sim, bundle, index, &end_index, mean_displacement);
 }
 
 double resident_memory_mib() {

@@ -1,9 +1,10 @@
 // Everything one process needs to plan on a bundle, built once and read-only afterwards (the
 // Pinocchio "model" side; each thread brings its own SimulatorWorkspace): the bundle (memory-
-// mapped, or read), its robot and environment (checked against the identity stored in the
-// bundle), the collision model, one simulator with the bundle's settings, and the k-d trees
-// over the edge starts and ends (mapped from the bundle's index file, or built). Shared by
-// lazyboe-query, lazyboe-bench and the Python module.
+// mapped, or read), its robot (checked against the identity stored in the bundle), its
+// settings and the k-d trees over the edge starts and ends (mapped from the bundle's index
+// file, or built); and apart from them the worlds it plans in (world.h: an environment, its
+// collision model and the simulator), the bundle's own scene by default, any other scene for
+// the same robot on request. Shared by lazyboe-query, lazyboe-bench and the Python module.
 #pragma once
 
 #include <chrono>
@@ -16,6 +17,7 @@
 #include "lazyboe/planning/edge_index_file.h"
 #include "lazyboe/planning/neighbour_index.h"
 #include "lazyboe/planning/planner.h"
+#include "lazyboe/planning/scene_cache.h"
 
 namespace lazyboe {
 
@@ -37,30 +39,37 @@ PlanningContext bundle_context(const Simulator& sim, const BundleView& bundle,
 
 class PlanningSession {
  public:
-  // Throws Error for a missing or corrupt bundle, or robot/environment files that do not match
-  // it. Empty robot_path/env_path: the files named in the bundle.
+  // Throws Error for a missing or corrupt bundle, or a robot that is not the bundle's. Empty
+  // robot_path: the config named in the bundle. Empty env_path: the bundle's own environment
+  // (the file named in the bundle, refused unless it still hashes to the recorded content);
+  // otherwise any environment for the bundle's robot becomes the default world.
   PlanningSession(const std::string& bundle_path, bool memory_map, const std::string& robot_path,
                   const std::string& env_path);
-  PlanningSession(const PlanningSession&) = delete;  // the simulator refers to members
+  PlanningSession(const PlanningSession&) = delete;  // members refer to members
   PlanningSession& operator=(const PlanningSession&) = delete;
 
  private:
   const std::chrono::steady_clock::time_point started_;  // first: times the members below
 
  public:
+  // What is mapped and shared, whatever the world (the model side):
   const BundleView bundle;
-  const BundleScene scene;
-  const CollisionModel collision;
+  const RobotModel robot;          // the bundle's, checked by content hash
   const BuildSettings settings;    // the bundle's simulation, command and region settings
-  const Simulator sim;             // trajectories are not sampled (sample_every = 0)
+  // The worlds planned in (world.h): the default, and scenes queries name (by content).
+  mutable SceneCache scenes;
   const BundleIndexes indexes;     // where they come from: indexes.source
   const EdgeIndex& index;          // edge start states: the planners' neighbourhoods
   const EdgeIndex& end_index;      // edge end states: goal coverage
   const double mean_displacement;  // mean_edge_displacement(bundle), for context()
-  const double load_seconds;       // wall time of everything above
+  const double load_seconds;  // wall time of everything above
 
-  // bundle_context of the session's simulator, bundle and indexes.
-  PlanningContext context() const;
+  const PlanningWorld& world() const { return *scenes.default_world(); }
+  const Simulator& sim() const { return world().sim; }  // the default world's
+
+  // bundle_context of the session's bundle and indexes in `world` (default: the default world).
+  PlanningContext context() const { return context(world()); }
+  PlanningContext context(const PlanningWorld& world) const;
   double default_theta() const { return bundle_theta(bundle); }
 };
 

@@ -46,15 +46,20 @@ const PlannerInfo* find_planner(const std::string& name) {
 
 const PlannerInfo& planner_info(const std::string& name, const std::string& where) {
   const PlannerInfo* info = find_planner(name);
-  if (!info) fail(where, "unknown planner '" + name + "' (expected " + planner_names_text() + ")");
+  if (!info) {
+    fail(where, "unknown planner '" + name + "' (expected " + planner_names_text() + ")" +
+                    did_you_mean(name, planner_names()));
+  }
   return *info;
 }
 
-std::string planner_names_text() {
+std::vector<std::string> planner_names() {
   std::vector<std::string> names;
   for (const PlannerInfo& info : planner_registry()) names.push_back(info.name);
-  return list_text(names);
+  return names;
 }
+
+std::string planner_names_text() { return list_text(planner_names()); }
 
 const std::vector<std::string>& all_parameter_names() {
   static const std::vector<std::string> names = [] {

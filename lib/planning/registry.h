@@ -50,6 +50,8 @@ const PlannerInfo* find_planner(const std::string& name);
 // The same, throwing Error("<where>: unknown planner 'x' (expected lazyboe, boe, ...)").
 const PlannerInfo& planner_info(const std::string& name, const std::string& where = "planner");
 
+// Every planner's name, in the registry's order.
+std::vector<std::string> planner_names();
 // "lazyboe, boe, rrt, sst, lazysp, ompl-rrt, ompl-sst or ompl-kpiece".
 std::string planner_names_text();
 

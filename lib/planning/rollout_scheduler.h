@@ -22,8 +22,8 @@ constexpr int kWavePerThread = 8;
 class RolloutScheduler {
  public:
   // Disabled (every rollout is the search's own) without a pool or with a pool of one thread.
-  explicit RolloutScheduler(RolloutPool* pool)
-      : pool_(pool && pool->threads() > 1 ? pool : nullptr) {}
+  RolloutScheduler(const Simulator& sim, RolloutPool* pool)
+      : sim_(&sim), pool_(pool && pool->threads() > 1 ? pool : nullptr) {}
 
   bool enabled() const { return pool_ != nullptr; }
 
@@ -71,7 +71,7 @@ class RolloutScheduler {
     }
     if (results_.size() < state_.size()) results_.resize(state_.size());
     wave_results_.resize(wave_.size());
-    pool_->run(tasks_.data(), wave_results_.data(), static_cast<int>(wave_.size()));
+    pool_->run(*sim_, tasks_.data(), wave_results_.data(), static_cast<int>(wave_.size()));
     rollouts_run_ += wave_.size();
     for (size_t w = 0; w < wave_.size(); ++w) {
       results_[wave_[w]] = wave_results_[w];
@@ -79,6 +79,7 @@ class RolloutScheduler {
     }
   }
 
+  const Simulator* sim_;  // the search's world
   RolloutPool* pool_;
   int node_ = -1;
   bool planned_ = false;

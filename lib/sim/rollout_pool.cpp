@@ -27,7 +27,7 @@ bool spin_until(Done done) {
 
 }  // namespace
 
-RolloutPool::RolloutPool(const Simulator& sim, int threads) : sim_(sim) {
+RolloutPool::RolloutPool(const Simulator& sim, int threads) : dof_(sim.robot.dof) {
   if (threads < 1) fail("threads", "must be at least 1, got " + std::to_string(threads));
   workspaces_.reserve(threads);
   for (int t = 0; t < threads; ++t) workspaces_.emplace_back(sim);
@@ -45,12 +45,13 @@ RolloutPool::~RolloutPool() {
 }
 
 void RolloutPool::run_tasks(int slot) {
-  const int n = sim_.robot.dof;
+  const Simulator& sim = *sim_;
+  const int n = sim.robot.dof;
   for (int k; (k = next_task_.fetch_add(1, std::memory_order_relaxed)) < count_;) {
     // simulate() throws nothing for valid inputs; an exception on a worker would end the
     // process, so the batch's first is handed to the caller.
     try {
-      results_[k] = simulate(sim_, workspaces_[slot],
+      results_[k] = simulate(sim, workspaces_[slot],
                              Eigen::Map<const Eigen::VectorXd>(tasks_[k].q0, n), tasks_[k].command);
     } catch (...) {
       std::lock_guard<std::mutex> lock(mutex_);
@@ -80,9 +81,12 @@ void RolloutPool::worker(int slot) {
   }
 }
 
-void RolloutPool::run(const RolloutTask* tasks, RolloutResult* results, int count) {
+void RolloutPool::run(const Simulator& sim, const RolloutTask* tasks, RolloutResult* results,
+                      int count) {
   if (count <= 0) return;
+  if (sim.robot.dof != dof_) fail("RolloutPool::run", "a simulator of another robot");
   rollouts_ += count;
+  sim_ = &sim;
   tasks_ = tasks;
   results_ = results;
   count_ = count;

@@ -27,7 +27,8 @@ struct RolloutTask {
 
 class RolloutPool {
  public:
-  // threads >= 1: the calling thread and threads - 1 workers.
+  // threads >= 1: the calling thread and threads - 1 workers, each with a workspace for
+  // `sim`'s robot (so for every world of that robot, world.h).
   RolloutPool(const Simulator& sim, int threads);
   ~RolloutPool();
   RolloutPool(const RolloutPool&) = delete;
@@ -36,8 +37,9 @@ class RolloutPool {
   int threads() const { return static_cast<int>(workspaces_.size()); }
 
   // results[k] = simulate(sim, ws, tasks[k].q0, tasks[k].command) for k < count, on all the
-  // pool's threads. One batch at a time: run is not to be called concurrently on one pool.
-  void run(const RolloutTask* tasks, RolloutResult* results, int count);
+  // pool's threads; `sim` is of the pool's robot, in any world. One batch at a time: run is not
+  // to be called concurrently on one pool.
+  void run(const Simulator& sim, const RolloutTask* tasks, RolloutResult* results, int count);
 
   // Rollouts run so far (used or not by the caller).
   uint64_t rollouts() const { return rollouts_; }
@@ -46,7 +48,8 @@ class RolloutPool {
   void worker(int slot);
   void run_tasks(int slot);  // takes tasks of the current batch until none is left
 
-  const Simulator& sim_;
+  const int dof_;                   // of the pool's robot
+  const Simulator* sim_ = nullptr;  // the current batch's
   uint64_t rollouts_ = 0;
   std::vector<SimulatorWorkspace> workspaces_;  // [0]: the calling thread's
   std::vector<std::thread> workers_;

@@ -1,7 +1,6 @@
-// lazyboe.PlanningSession, lazyboe.planners(): queries in the query format's terms (parsed and
-// validated by parse_query, planned by the registry's plan, post-processed by make_executable
-// or, raw, realized by realize_path, exactly as lazyboe-query does), with the GIL released
-// while planning.
+// lazyboe.PlanningSession, lazyboe.planners(): queries in the query format's terms (read and
+// validated by read_query, answered by answer_request, exactly as lazyboe-query does), with the
+// GIL released while planning.
 #include <omp.h>
 #include <pybind11/stl.h>
 
@@ -28,15 +27,14 @@ struct PyTrajectory {
 // One answered query: what lazyboe-query's result line holds.
 struct PyResult {
   Query query;
-  PlanResult result;
-  Trajectory trajectory;  // when result.success
-  bool raw = false;       // the planner's edge chain, not post-processed
-  ExecutionStats execution;
+  PlanAnswer answer;
+  WorldPtr world;  // the scene it was planned in
 
   nlohmann::json json() const {
-    return result_json(query, result, result.success ? &trajectory : nullptr,
-                       TrajectoryOutput::Inline, "", raw ? nullptr : &execution);
+    return result_json(query, answer, *world, TrajectoryOutput::Inline, "");
   }
+  const PlanResult& result() const { return answer.result; }
+  const Trajectory& trajectory() const { return answer.trajectory; }
 };
 
 PyTrajectory trajectory_of(const Trajectory& tr, int dof) {
@@ -56,45 +54,37 @@ PyTrajectory trajectory_of(const Trajectory& tr, int dof) {
 
 struct Session {
   std::shared_ptr<const PlanningSession> session;
-  std::unique_ptr<const PlanningContext> context;
-  ExecutionOptions execution;  // lazyboe-query's defaults: the bundle's command limits
-  int sample_every(double interval) const {
-    if (!(interval > 0)) throw InputError("sample_interval: must be > 0");
-    return std::max(1, sample_every_ticks(interval, session->scene.robot.control_rate));
-  }
 };
 
-// "line 0: goal.q: ..." from parse_query, without the line (there is none in Python).
-std::string without_line(const std::string& what) {
-  const std::string prefix = "line 0: ";
-  return what.rfind(prefix, 0) == 0 ? what.substr(prefix.size()) : what;
+// What to return, as lazyboe-query's flags say it.
+QueryDefaults query_defaults(double sample_interval, bool raw) {
+  if (!(sample_interval > 0)) throw InputError("sample_interval: must be > 0");
+  QueryDefaults d;
+  d.output.sample_interval = sample_interval;
+  d.output.raw = raw;
+  return d;
 }
 
-Query parse(const Session& s, SimulatorWorkspace& ws, const nlohmann::json& doc,
-            const std::string& where) {
-  std::string id;
+// `where` starts the errors: "" (plan: the field alone) or "queries[2]".
+Query read(const Session& s, SimulatorWorkspace& ws, const nlohmann::json& doc,
+           const std::string& where, const QueryDefaults& defaults) {
   try {
-    return parse_query(doc.dump(), 0, s.session->scene.robot, s.session->sim, ws, QueryDefaults{},
-                       id);
+    return read_query(doc, where, s.session->sim(), ws, defaults, &s.session->scenes);
   } catch (const Error& e) {
-    throw InputError(where + without_line(e.what()));
+    throw InputError(e.what());
   }
 }
 
-PyResult answer(const Session& s, SimulatorWorkspace& ws, RolloutPool& pool, const Query& q,
-                int sample_every, bool raw) {
-  PyResult r{q, {}, {}, raw, {}};
-  r.result = plan(*s.context, ws, q.planner, q.parameters, q.problem, &pool);
-  if (r.result.success) {
-    r.trajectory = returned_trajectory(s.session->sim, ws, q.problem, r.result.best_path, raw,
-                                       s.execution, sample_every, r.execution);
-  }
+PyResult answer(const Session& s, SimulatorWorkspace& ws, RolloutPool& pool, const Query& q) {
+  PyResult r{q, {}, q.world ? q.world : s.session->scenes.default_world()};
+  r.answer = answer_request(s.session->context(*r.world), q.request, ws, &pool);
   return r;
 }
 
 nlohmann::json query_doc(const py::object& start, const py::object& goal,
                          const std::string& planner, const py::object& budget,
-                         const py::object& seed, const std::string& id, const py::kwargs& params) {
+                         const py::object& seed, const std::string& id, const py::object& scene,
+                         const py::kwargs& params) {
   nlohmann::json doc = nlohmann::json::object();
   doc["id"] = id;
   doc["start"] = to_json(start, "start");
@@ -102,6 +92,10 @@ nlohmann::json query_doc(const py::object& start, const py::object& goal,
   doc["planner"] = planner;
   if (!budget.is_none()) doc["budget"] = to_json(budget, "budget");
   if (!seed.is_none()) doc["seed"] = to_json(seed, "seed");
+  if (py::isinstance<py::dict>(scene))
+    doc["scene"] = to_json(scene, "scene");
+  else if (!scene.is_none())
+    doc["scene"] = py::str(scene).cast<std::string>();  // a path (str or os.PathLike)
   for (const auto& [k, v] : params) {
     const std::string name = k.cast<std::string>();
     doc[name] = to_json(v, name);
@@ -111,16 +105,16 @@ nlohmann::json query_doc(const py::object& start, const py::object& goal,
 
 PyResult plan_one(const Session& s, const py::object& start, const py::object& goal,
                   const std::string& planner, const py::object& budget, const py::object& seed,
-                  const std::string& id, double sample_interval, int sim_threads, bool raw,
-                  const py::kwargs& params) {
+                  const std::string& id, const py::object& scene, double sample_interval,
+                  int sim_threads, bool raw, const py::kwargs& params) {
   if (sim_threads < 1 || sim_threads > 1024) throw InputError("sim_threads: must be in [1, 1024]");
-  const int every = s.sample_every(sample_interval);
-  const nlohmann::json doc = query_doc(start, goal, planner, budget, seed, id, params);
+  const QueryDefaults defaults = query_defaults(sample_interval, raw);
+  const nlohmann::json doc = query_doc(start, goal, planner, budget, seed, id, scene, params);
   py::gil_scoped_release free;
-  SimulatorWorkspace ws(s.session->sim);
-  const Query q = parse(s, ws, doc, "");
-  RolloutPool pool(s.session->sim, sim_threads);
-  return answer(s, ws, pool, q, every, raw);
+  SimulatorWorkspace ws(s.session->sim());
+  const Query q = read(s, ws, doc, "", defaults);
+  RolloutPool pool(s.session->sim(), sim_threads);
+  return answer(s, ws, pool, q);
 }
 
 // Ctrl-C during a batch: the calling thread (OpenMP's thread 0) looks for a pending signal
@@ -144,25 +138,25 @@ struct BatchInterrupt {
 // Every query parsed (checked) first, then planned on `jobs` threads; the first error a
 // planner throws is `failure`.
 std::vector<PyResult> plan_parsed(const Session& s, const std::vector<nlohmann::json>& docs,
-                                  int jobs, int every, bool raw, BatchInterrupt& interrupt,
-                                  std::exception_ptr& failure) {
+                                  int jobs, const QueryDefaults& defaults,
+                                  BatchInterrupt& interrupt, std::exception_ptr& failure) {
   std::vector<Query> parsed;
   {
-    SimulatorWorkspace ws(s.session->sim);
+    SimulatorWorkspace ws(s.session->sim());
     for (size_t k = 0; k < docs.size(); ++k)
-      parsed.push_back(parse(s, ws, docs[k], "queries[" + std::to_string(k) + "]: "));
+      parsed.push_back(read(s, ws, docs[k], "queries[" + std::to_string(k) + "]", defaults));
   }
   std::vector<PyResult> results(parsed.size());
   std::vector<std::exception_ptr> errors(parsed.size());
 #pragma omp parallel num_threads(jobs)
   {
-    SimulatorWorkspace ws(s.session->sim);
-    RolloutPool pool(s.session->sim, 1);
+    SimulatorWorkspace ws(s.session->sim());
+    RolloutPool pool(s.session->sim(), 1);
 #pragma omp for schedule(dynamic, 1)
     for (long k = 0; k < static_cast<long>(parsed.size()); ++k) {
       if (interrupt.check()) continue;
       try {
-        results[k] = answer(s, ws, pool, parsed[k], every, raw);
+        results[k] = answer(s, ws, pool, parsed[k]);
       } catch (...) {
         errors[k] = std::current_exception();
       }
@@ -177,7 +171,7 @@ std::vector<PyResult> plan_many(const Session& s, const py::iterable& queries, i
                                 double sample_interval, bool raw) {
   if (jobs < 0 || jobs > 1024) throw InputError("jobs: must be in [0, 1024]");
   if (jobs == 0) jobs = omp_get_num_procs();
-  const int every = s.sample_every(sample_interval);
+  const QueryDefaults defaults = query_defaults(sample_interval, raw);
   std::vector<nlohmann::json> docs;
   for (const py::handle& q : queries) {
     const std::string where = "queries[" + std::to_string(docs.size()) + "]";
@@ -191,7 +185,7 @@ std::vector<PyResult> plan_many(const Session& s, const py::iterable& queries, i
   std::vector<PyResult> results;
   {
     py::gil_scoped_release free;
-    results = plan_parsed(s, docs, jobs, every, raw, interrupt, failure);
+    results = plan_parsed(s, docs, jobs, defaults, interrupt, failure);
   }
   if (interrupt.error) std::rethrow_exception(interrupt.error);
   if (failure) std::rethrow_exception(failure);
@@ -266,23 +260,23 @@ void bind_result(py::module_& m) {
       .def_property_readonly(
           "id", [](const PyResult& r) { return r.query.id; }, "The query id.")
       .def_property_readonly(
-          "planner", [](const PyResult& r) { return r.query.planner; },
+          "planner", [](const PyResult& r) { return r.query.request.planner; },
           "The planner that answered.")
       .def_property_readonly(
-          "success", [](const PyResult& r) { return r.result.success; },
+          "success", [](const PyResult& r) { return r.result().success; },
           "A solution was found (and realized).")
       .def_property_readonly(
           "time_to_first_solution",
           [opt](const PyResult& r) {
-            return opt(r.result.success, r.result.time_to_first_solution);
+            return opt(r.result().success, r.result().time_to_first_solution);
           },
           "Seconds to the first solution; None without one.")
       .def_property_readonly(
-          "n_solutions", [](const PyResult& r) { return r.result.n_solutions; },
+          "n_solutions", [](const PyResult& r) { return r.result().n_solutions; },
           "Solutions found within the budget.")
       .def_property_readonly(
           "best_cost",
-          [opt](const PyResult& r) { return opt(r.result.success, r.trajectory.cost); },
+          [opt](const PyResult& r) { return opt(r.result().success, r.trajectory().cost); },
           "Joint-space arc length of the realized best path, rad; None without one.")
       .def_property_readonly(
           "counters", [](const PyResult& r) { return from_json(r.json()["counters"]); },
@@ -290,43 +284,50 @@ void bind_result(py::module_& m) {
       .def_property_readonly(
           "failure",
           [](const PyResult& r) -> py::object {
-            return r.result.success ? py::object(py::none()) : py::str(r.result.failure);
+            return r.result().success ? py::object(py::none()) : py::str(r.result().failure);
           },
           "Why there is no solution; None with one.")
       .def_property_readonly(
           "found_by",
           [](const PyResult& r) -> py::object {
-            return r.result.found_by.empty() || !r.result.success ? py::object(py::none())
-                                                                  : py::str(r.result.found_by);
+            return r.result().found_by.empty() || !r.result().success ? py::object(py::none())
+                                                                  : py::str(r.result().found_by);
           },
           "Which part of the planner found the best path (lazysp: bundle or growth), or None.")
       .def_property_readonly(
           "duration",
-          [opt](const PyResult& r) { return opt(r.result.success, r.trajectory.duration); },
+          [opt](const PyResult& r) { return opt(r.result().success, r.trajectory().duration); },
           "Duration of the trajectory, s; None without one.")
       .def_property_readonly(
           "edges",
           [](const PyResult& r) -> py::object {
-            if (!r.result.success) return py::none();
-            return trajectory_of(r.trajectory, 0).edges;
+            if (!r.result().success) return py::none();
+            return trajectory_of(r.trajectory(), 0).edges;
           },
           "Bundle edge of each step of the best path (-1: not a bundle edge); None without one.")
       .def_property_readonly(
           "trajectory",
           [](const PyResult& r) -> py::object {
-            if (!r.result.success) return py::none();
+            if (!r.result().success) return py::none();
             return py::cast(
-                trajectory_of(r.trajectory, static_cast<int>(r.query.problem.start.size())));
+                trajectory_of(r.trajectory(), static_cast<int>(r.query.request.problem.start.size())));
           },
           "The trajectory (t, q, dq, ddq, cmd, edges, cost, duration, stops): the executable one, "
           "or the raw chain with raw=True; None without a solution.")
+      .def_property_readonly(
+          "scene",
+          [](const PyResult& r) {
+            return py::dict(py::arg("name") = r.world->env.name,
+                            py::arg("hash") = r.world->env.identity);
+          },
+          "The scene it was planned in: {'name', 'hash'}.")
       .def(
           "to_dict", [](const PyResult& r) { return from_json(r.json()); },
           "The result line of lazyboe-query --trajectories inline, as a dict.")
       .def("__repr__", [](const PyResult& r) {
-        return "<lazyboe.PlanResult " + r.query.planner +
-               (r.result.success ? ": solved, cost " + std::to_string(r.trajectory.cost)
-                                 : ": " + r.result.failure) +
+        return "<lazyboe.PlanResult " + r.query.request.planner +
+               (r.result().success ? ": solved, cost " + std::to_string(r.trajectory().cost)
+                                 : ": " + r.result().failure) +
                ">";
       });
 }
@@ -355,23 +356,24 @@ void bind_planning(py::module_& m) {
                s.session = file_errors(
                    [&] { return std::make_shared<const PlanningSession>(p, memory_map, r, e); });
              }
-             s.context = std::make_unique<const PlanningContext>(s.session->context());
-             s.execution.limits = s.context->command;
              return s;
            }),
            py::arg("bundle_path"), py::arg("memory_map") = true, py::arg("robot") = py::none(),
            py::arg("env") = py::none(),
-           "Opens a bundle for planning. robot/env: config and environment files (default: "
-           "those named in the bundle; refused unless they match it). OSError for a missing or "
-           "corrupt bundle or mismatching files.")
+           "Opens a bundle for planning. robot: the bundle's robot config (default: the one "
+           "named in the bundle; refused unless it matches). env: the environment planned in by "
+           "default (default: the bundle's own; any scene for the bundle's robot). OSError for "
+           "a missing or corrupt bundle or a mismatching robot.")
       .def("plan", &plan_one, py::arg("start"), py::arg("goal"), py::arg("planner") = "lazyboe",
            py::arg("budget") = py::none(), py::arg("seed") = py::none(), py::arg("id") = "",
-           py::arg("sample_interval") = 0.01, py::arg("sim_threads") = 1, py::arg("raw") = false,
+           py::arg("scene") = py::none(), py::arg("sample_interval") = 0.01, py::arg("sim_threads") = 1, py::arg("raw") = false,
            "Plans one query, as a line of lazyboe-query would: start (dof values), goal "
            "({'q': [...], 'tolerance': 0.1} or {'position': [x, y, z], 'tolerance': 0.02, "
            "'link': name}), planner (lazyboe.planners()), budget (s, default 5), seed (default "
            "1), and the planner's parameters by name as keywords (stop_at_first=True, "
-           "theta=0.4, ...). sample_interval: trajectory sample spacing, s (0.001: every control "
+           "theta=0.4, ...). scene: the environment to plan in, an environment file's path or an "
+           "environment dict (default: the session's); scenes are kept by content, so naming "
+           "one again reuses its collision model. sample_interval: trajectory sample spacing, s (0.001: every control "
            "tick); sim_threads: threads simulating one query's edges (the answer does not depend "
            "on it); raw: the planner's edge chain with a stop at every junction (lazyboe-query "
            "--raw) instead of the executable trajectory (blended, shortcut). ValueError "
@@ -385,7 +387,7 @@ void bind_planning(py::module_& m) {
       .def_property_readonly(
           "robot",
           [](const Session& s) {
-            return PyRobot{std::shared_ptr<const RobotModel>(s.session, &s.session->scene.robot)};
+            return PyRobot{std::shared_ptr<const RobotModel>(s.session, &s.session->robot)};
           },
           "The bundle's robot (a lazyboe.Robot).")
       .def_property_readonly(
@@ -395,6 +397,13 @@ void bind_planning(py::module_& m) {
                 std::shared_ptr<const BundleView>(s.session, &s.session->bundle));
           },
           "The bundle (a lazyboe.Bundle sharing the session's mapping).")
+      .def_property_readonly(
+          "scene",
+          [](const Session& s) {
+            const Environment& env = s.session->world().env;
+            return py::dict(py::arg("name") = env.name, py::arg("hash") = env.identity);
+          },
+          "The default scene planned in: {'name', 'hash'} (the content hash results carry).")
       .def_property_readonly(
           "load_seconds", [](const Session& s) { return s.session->load_seconds; },
           "Wall time of opening the session, s.")

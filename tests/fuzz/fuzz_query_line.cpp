@@ -11,7 +11,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string text(reinterpret_cast<const char*>(data), size);
   std::string id;
   try {
-    const Query q = parse_query(text, 1, scene.robot, scene.sim, scene.ws, QueryDefaults{}, id);
+    const Query q = parse_query(text, 1, scene.sim, scene.ws, QueryDefaults{}, id);
     (void)q;
   } catch (const Error& e) {
     // lazyboe-query answers a refused line with this result line; it must serialize.

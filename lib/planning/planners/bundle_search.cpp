@@ -50,7 +50,7 @@ bool edge_ends_near(const PlanningContext& ctx, const JointVectorRef& q, double 
 BundleSearch::BundleSearch(const PlanningContext& ctx, SimulatorWorkspace& ws,
                            const PlanningProblem& p, double theta, RolloutPool* pool,
                            const ParameterValues&)
-    : ctx_(ctx), bundle_(*ctx.bundle), s_(ctx, ws, p), theta_(theta), ahead_(pool) {}
+    : ctx_(ctx), bundle_(*ctx.bundle), s_(ctx, ws, p), theta_(theta), ahead_(ctx.sim, pool) {}
 
 JointVector BundleSearch::edge_end(uint32_t e) const { return row(bundle_.qf(e), bundle_.dof()); }
 JointVector BundleSearch::edge_start(uint32_t e) const { return row(bundle_.q0(e), bundle_.dof()); }

@@ -1,0 +1,37 @@
+#include "lazyboe/planning/scene_cache.h"
+
+namespace lazyboe {
+
+SceneCache::SceneCache(const RobotModel& robot, const SimulationOptions& options,
+                       WorldPtr default_world, size_t capacity)
+    : robot_(robot),
+      options_(options),
+      default_world_(std::move(default_world)),
+      capacity_(capacity) {}
+
+WorldPtr SceneCache::load(const std::string& path) { return world(load_environment(path)); }
+
+WorldPtr SceneCache::inline_scene(const JsonField& scene) {
+  return world(environment_from_json(scene, ""));
+}
+
+WorldPtr SceneCache::world(Environment env) {
+  if (env.identity == default_world_->env.identity) return default_world_;
+  {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    for (auto it = recent_.begin(); it != recent_.end(); ++it) {
+      if ((*it)->env.identity != env.identity) continue;
+      recent_.splice(recent_.begin(), recent_, it);
+      return recent_.front();
+    }
+  }
+  // Built outside the lock (FCL's geometry takes milliseconds); two threads asking for one new
+  // scene at once may each build it: both are the same world.
+  auto made = std::make_shared<const PlanningWorld>(robot_, std::move(env), options_);
+  const std::lock_guard<std::mutex> lock(mutex_);
+  recent_.push_front(made);
+  if (recent_.size() > capacity_) recent_.pop_back();
+  return made;
+}
+
+}  // namespace lazyboe

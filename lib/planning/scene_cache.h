@@ -1,0 +1,39 @@
+// The worlds one session plans in: its default (the bundle's own scene, or the one given at
+// start) and those queries name, by environment file or inline. Worlds are kept by content
+// (Environment::identity: the parsed scene, so whitespace or key order do not count), so a
+// scene named by many queries has its collision model built once; the most recently used
+// `capacity` are kept, a world in use stays alive with its holders. Thread-safe.
+#pragma once
+
+#include <list>
+#include <mutex>
+#include <string>
+
+#include "lazyboe/common/json_fields.h"
+#include "lazyboe/planning/world.h"
+
+namespace lazyboe {
+
+class SceneCache {
+ public:
+  SceneCache(const RobotModel& robot, const SimulationOptions& options, WorldPtr default_world,
+             size_t capacity = 16);
+
+  const WorldPtr& default_world() const { return default_world_; }
+  // The world of an environment file (errors name the file and field).
+  WorldPtr load(const std::string& path);
+  // The world of an environment object held in memory (a query's inline "scene").
+  WorldPtr inline_scene(const JsonField& scene);
+  // The world of a parsed environment.
+  WorldPtr world(Environment env);
+
+ private:
+  const RobotModel& robot_;
+  const SimulationOptions options_;
+  const WorldPtr default_world_;
+  const size_t capacity_;
+  std::mutex mutex_;
+  std::list<WorldPtr> recent_;  // most recently used first
+};
+
+}  // namespace lazyboe
