@@ -6,7 +6,7 @@
 // identical results for a fixed seed, and with parallel rollouts; error results for bad query
 // lines while the rest of the batch succeeds; memory-mapped and read-into-memory bundles agree;
 // refusal of incomplete, missing and unperturbed bundles; streaming from standard input;
-// robot/environment identity; CSV trajectories; a start or goal outside the bundle's coverage
+// robot identity, any environment; CSV trajectories; a start or goal outside the bundle's coverage
 // fails with a reason.
 //
 // Run time matters (the whole binary should stay well under a minute on two cores): one bundle
@@ -511,6 +511,25 @@ TEST(QueryCli, BadLinesGetErrorResultsAndTheOthersStillSucceed) {
       query("limits", outside, f.b, "boe", 1, true).dump(),       // line 8
       query("good-2", f.b, f.a, "boe", 2, true).dump(),           // line 9
   };
+  json other = query("other", f.a, f.b, "boe", 1, true);
+  other["lazy_model"] = "transfer";  // lazyboe's: silently ignored, it would mislead
+  lines.push_back(other.dump());     // line 10
+  json misspelt = query("misspelt", f.a, f.b, "boe", 1, true);
+  misspelt["stop_at_frist"] = true;
+  lines.push_back(misspelt.dump());  // line 11
+  json no_scene = query("no-scene", f.a, f.b, "boe", 1, true);
+  no_scene["scene"] = "no-such-scene.json";
+  lines.push_back(no_scene.dump());  // line 12
+  json foreign = query("foreign", f.a, f.b, "boe", 1, true);
+  foreign["scene"] = {{"schema_version", 1},
+                      {"name", "foreign"},
+                      {"objects",
+                       {{{"name", "floor"},
+                         {"type", "box"},
+                         {"size", {1, 1, 0.02}},
+                         {"position", {0, 0, -0.01}},
+                         {"allowed_links", {"ur5_base_link"}}}}}};
+  lines.push_back(foreign.dump());  // line 13
   std::string text;
   for (const std::string& l : lines) text += l + "\n";
   const std::string file = write_temp_file("bad.jsonl", text);
@@ -530,6 +549,10 @@ TEST(QueryCli, BadLinesGetErrorResultsAndTheOthersStillSucceed) {
       {6, "unknown", {"planner", "astar"}},
       {8, "limits", {"start", "limit"}},
       {9, "good-2", {}},
+      {10, "other", {"lazy_model: not a parameter of boe", "theta"}},
+      {11, "misspelt", {"stop_at_frist: unknown field (did you mean 'stop_at_first'?)"}},
+      {12, "no-scene", {"scene: no-such-scene.json"}},
+      {13, "foreign", {"scene", "ur5_base_link", "is not a link of robot"}},
   };
   ASSERT_EQ(t.results.size(), expected.size()) << "one result per non-empty line\n"
                                                << describe(t.r);
@@ -736,7 +759,7 @@ TEST(QueryCli, StreamingFromStandardInputFlushesOneLinePerQuery) {
 // 8. Robot and environment identity; CSV trajectories
 // ------------------------------------------------------------------------------------------
 
-TEST(QueryCli, RobotOrEnvironmentOtherThanTheBundlesIsRefusedAtStart) {
+TEST(QueryCli, RobotOtherThanTheBundlesIsRefusedAtStartAnyEnvironmentIsPlannedIn) {
   const Fixture& f = fixture();
   const std::string dir = fresh_dir("identity");
   const std::string queries =
@@ -756,24 +779,25 @@ TEST(QueryCli, RobotOrEnvironmentOtherThanTheBundlesIsRefusedAtStart) {
   robot["description"] = "a copy of the Panda, not the bundle's";
   const std::string other_robot = write_temp_file("identity/other-robot.json", robot.dump(2));
   ASSERT_NO_THROW(load_robot(other_robot));  // a valid robot, only not the bundle's
-  const std::string shelf = source_path("data/environments/shelf.json");
-  struct Case {
-    std::vector<std::string> args;
-    std::string names;
-  };
-  for (const Case& c :
-       {Case{{"--robot", other_robot}, other_robot}, Case{{"--env", shelf}, shelf}}) {
-    SCOPED_TRACE(c.names);
+  {
     const std::string out = dir + "/refused.jsonl";
-    std::vector<std::string> args = {"--bundle", f.path, "--queries", queries, "--out", out};
-    args.insert(args.end(), c.args.begin(), c.args.end());
-    const CommandResult r = run(query_command(args));
+    const CommandResult r = run(query_command(
+        {"--bundle", f.path, "--queries", queries, "--out", out, "--robot", other_robot}));
     EXPECT_EQ(r.exit_code, 1) << describe(r);
     EXPECT_EQ(count_lines(r.err), 1) << describe(r);
-    EXPECT_TRUE(contains(r.err, c.names)) << describe(r);
+    EXPECT_TRUE(contains(r.err, other_robot)) << describe(r);
+    EXPECT_TRUE(contains(r.err, "not the robot")) << describe(r);
     EXPECT_TRUE(r.out.empty()) << describe(r);
     EXPECT_FALSE(fs::exists(out)) << "results written although refused";
   }
+  // Another environment: the scene the queries are planned in (the bundle's edges are
+  // dynamics, true in any scene); each result names it.
+  const ToolRun t = query_tool({"--bundle", f.path, "--queries", queries, "--env",
+                                source_path("data/environments/empty.json"), "--quiet"});
+  EXPECT_EQ(t.r.exit_code, 0) << describe(t.r);
+  ASSERT_EQ(t.results.size(), 1u) << describe(t.r);
+  EXPECT_EQ(t.results[0]["scene"]["name"], "empty") << t.results[0].dump();
+  EXPECT_TRUE(t.results[0]["success"].get<bool>()) << t.results[0].dump();
 }
 
 // Parses a CSV file into its header and rows of numbers.
@@ -918,6 +942,15 @@ TEST(QueryCli, RawGivesThePlannersEdgeChainsAndPostProcessingIsShorter) {
     EXPECT_EQ(resimulate(f, start, bundle_commands(f, traj.edges), traj), "");
   }
   EXPECT_GT(shorter, 0) << "post-processing never shortened a trajectory";
+
+  // A query's own "raw" overrides the flag: the same answer as --raw.
+  json first = queries[0];
+  first["raw"] = true;
+  const ToolRun one = run_batch("raw-field", {first}, {"--trajectories", "inline", "--quiet"});
+  expect_batch_ran(one, 1);
+  json a = one.results[0], b = raw.results[0];
+  for (json* r : {&a, &b}) r->erase("time_to_first_solution");
+  EXPECT_EQ(a, b);
 }
 
 // Result lines, post-processed and raw, follow schemas/result.schema.json (validated by

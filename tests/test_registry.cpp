@@ -88,6 +88,9 @@ TEST(Registry, NamesAndLookups) {
   EXPECT_EQ(find_planner("prm"), nullptr);
   const std::string e = message_of([] { planner_info("prm"); });
   EXPECT_EQ(e, "planner: unknown planner 'prm' (expected " + planner_names_text() + ")");
+  EXPECT_EQ(message_of([] { planner_info("lazyps"); }),
+            "planner: unknown planner 'lazyps' (expected " + planner_names_text() +
+                ") (did you mean 'lazysp'?)");
   EXPECT_TRUE(find_planner("lazyboe")->needs.perturbation);
   EXPECT_TRUE(find_planner("boe")->needs.bundle);
   EXPECT_FALSE(find_planner("boe")->needs.perturbation);

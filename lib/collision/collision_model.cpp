@@ -193,7 +193,7 @@ CollisionModel build_collision_model(const RobotModel& robot, const Environment&
     for (const std::string& name : env.obstacles[o].allowed_links) {
       const int link = robot.link_index(name);
       if (link < 0) {
-        fail(env.origin, "object '" + env.obstacles[o].name + "': allowed link '" + name +
+        fail(env.origin.empty() ? env.path : env.origin, "object '" + env.obstacles[o].name + "': allowed link '" + name +
                            "' is not a link of robot '" + robot.name + "'");
       }
       allowed.push_back(link);

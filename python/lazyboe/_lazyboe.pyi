@@ -101,6 +101,7 @@ class PlanResult:
     duration: Optional[float]
     edges: Optional[npt.NDArray[np.int64]]
     trajectory: Optional[Trajectory]
+    scene: dict[str, str]
     def to_dict(self) -> dict[str, Any]: ...
 
 class PlanningSession:
@@ -109,11 +110,12 @@ class PlanningSession:
     load_seconds: float
     index_source: str
     default_theta: float
+    scene: dict[str, str]
     def __init__(self, bundle_path: Path, memory_map: bool = True, robot: Optional[Path] = None,
                  env: Optional[Path] = None) -> None: ...
     def plan(self, start: ArrayLike, goal: dict[str, Any], planner: str = "lazyboe",
              budget: Optional[float] = None, seed: Optional[int] = None, id: str = "",
-             sample_interval: float = 0.01, sim_threads: int = 1, raw: bool = False,
+             scene: Union[Path, dict[str, Any], None] = None, sample_interval: float = 0.01, sim_threads: int = 1, raw: bool = False,
              **params: Any) -> PlanResult: ...
     def plan_many(self, queries: Iterable[dict[str, Any]], jobs: int = 0,
                   sample_interval: float = 0.01, raw: bool = False) -> list[PlanResult]: ...
