@@ -7,6 +7,8 @@ packages=(
   build-essential cmake pkg-config
   libeigen3-dev libfcl-dev liburdfdom-dev libtinyxml-dev libhdf5-dev libcli11-dev
   nlohmann-json3-dev
+  # Obstacles given as meshes and point clouds (Assimp) and as OctoMap octrees (issue 26).
+  libassimp-dev liboctomap-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   python3 python3-jsonschema
   # The Python module (python/) and its tests: built for and run by Debian's /usr/bin/python3.

@@ -3,9 +3,13 @@
 configurations of a sub-box of the sampling region, checked with `lazyboe-robot check`.
 
 usage: make-queries.py OUT.jsonl COUNT SEED [--env FILE] [--tolerance T] [--planners a,b]
-                      [--box central|region] [--robot FILE]
+                      [--box central|region] [--robot FILE] [--blocked] [--min-separation R]
+
+--blocked keeps only pairs whose straight joint-space line collides in the scene (checked at
+every 0.02 rad with lazyboe-robot check): problems a single straight command cannot solve. It
+prints the share of candidate pairs that were blocked.
 """
-import argparse, csv, json, os, random, subprocess, sys, tempfile
+import argparse, csv, json, math, os, random, subprocess, sys, tempfile
 
 p = argparse.ArgumentParser()
 p.add_argument("out"); p.add_argument("count", type=int); p.add_argument("seed", type=int)
@@ -15,6 +19,10 @@ p.add_argument("--budget", type=float, default=2.0)
 p.add_argument("--planners", default="lazyboe,boe,rrt,sst")
 p.add_argument("--tool", default="build/bin/lazyboe-robot")
 p.add_argument("--robot", default="data/robots/panda.json")
+p.add_argument("--blocked", action="store_true",
+               help="only pairs whose straight joint-space line collides in the scene")
+p.add_argument("--min-separation", type=float, default=0.0,
+               help="smallest joint-space distance between start and goal, rad")
 p.add_argument("--box", choices=["central", "region"], default="central",
                help="central: the middle of the Panda's region, where a small demo bundle is "
                "dense enough; region: the robot config's whole sampling region")
@@ -26,19 +34,48 @@ else:
     region = json.load(open(a.robot))["sampling_region"]
     lo, hi = region["lower"], region["upper"]
 rng = random.Random(a.seed)
-with tempfile.TemporaryDirectory() as d:
-    cand = [[round(rng.uniform(l, h), 4) for l, h in zip(lo, hi)] for _ in range(8 * a.count)]
-    inp, res = os.path.join(d, "in.csv"), os.path.join(d, "out.csv")
-    with open(inp, "w") as f:
-        f.write(",".join(f"q{i}" for i in range(1, 8)) + "\n")
-        f.writelines(",".join(map(str, q)) + "\n" for q in cand)
-    subprocess.run([a.tool, "--robot", a.robot, "check", "--env", a.env, "--in", inp, "--out", res], check=True,
-                   stderr=subprocess.DEVNULL)
-    rows = list(csv.DictReader(open(res)))
-free = [q for q, r in zip(cand, rows)
-        if r["in_limits"] == "1" and r["self_collision"] == "0" and r["env_collision"] == "0"
-        and float(r["min_distance"]) > 0.03]
-pairs = [(free[2 * i], free[2 * i + 1]) for i in range(a.count)]
+
+
+def check(configs):
+    """lazyboe-robot check of each configuration: True where it is free (with 3 cm clearance)."""
+    with tempfile.TemporaryDirectory() as d:
+        inp, res = os.path.join(d, "in.csv"), os.path.join(d, "out.csv")
+        with open(inp, "w") as f:
+            f.write(",".join(f"q{i}" for i in range(1, len(configs[0]) + 1)) + "\n")
+            f.writelines(",".join(map(str, q)) + "\n" for q in configs)
+        subprocess.run([a.tool, "--robot", a.robot, "check", "--env", a.env, "--in", inp, "--out", res],
+                       check=True, stderr=subprocess.DEVNULL)
+        rows = list(csv.DictReader(open(res)))
+    return [r["in_limits"] == "1" and r["self_collision"] == "0" and r["env_collision"] == "0"
+            and float(r["min_distance"]) > 0.03 for r in rows]
+
+
+def line_blocked(s, g):
+    n = max(2, int(math.dist(s, g) / 0.02) + 1)
+    line = [[s[i] + (g[i] - s[i]) * k / n for i in range(len(s))] for k in range(1, n)]
+    return not all(check(line))
+
+
+cand = [[round(rng.uniform(l, h), 4) for l, h in zip(lo, hi)] for _ in range(40 * a.count)]
+free = [q for q, ok in zip(cand, check(cand)) if ok]
+pairs, tried, blocked = [], 0, 0
+for i in range(0, len(free) - 1, 2):
+    if len(pairs) == a.count:
+        break
+    s, g = free[i], free[i + 1]
+    if math.dist(s, g) < a.min_separation:
+        continue
+    tried += 1
+    if a.blocked:
+        if not line_blocked(s, g):
+            continue
+        blocked += 1
+    pairs.append((s, g))
+if len(pairs) < a.count:
+    sys.exit(f"make-queries: only {len(pairs)} of {a.count} problems found; try another seed or scene")
+if a.blocked:
+    print(f"{blocked} of {tried} pairs tried had a blocked straight line "
+          f"({100.0 * blocked / tried:.0f}%)", file=sys.stderr)
 with open(a.out, "w") as f:
     for i, (s, g) in enumerate(pairs):
         for planner in a.planners.split(","):

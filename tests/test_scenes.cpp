@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "box_files.h"
 #include "cli_util.h"
 #include "lazyboe/bundle/bundle_file.h"
 #include "lazyboe/bundle/bundle_view.h"
@@ -132,9 +133,9 @@ CheckCounts check_samples(const std::string& name, const json& result,
   return c;
 }
 
-// A ball of radius `radius` on the hand's way through `result`'s trajectory (near its middle)
-// that leaves the start and the goal free; the table scene with it, as JSON.
-json blocked_scene(const json& result, double radius) {
+// `object` (without a position) on the hand's way through `result`'s trajectory (near its
+// middle), where it leaves the start and the goal free; the table scene with it, as JSON.
+json blocked_scene(const json& result, const json& object) {
   const Fixture& f = fixture();
   const RobotModel& robot = f.session.robot;
   const json& rows = result.at("trajectory").at("q");
@@ -148,25 +149,26 @@ json blocked_scene(const json& result, double radius) {
       const Eigen::Vector3d p = link_pose(robot, data, hand).p;
       json scene = table_scene();
       scene["name"] = "table-with-ball";
-      scene["objects"].push_back({{"name", "ball"},
-                                  {"type", "sphere"},
-                                  {"radius", radius},
-                                  {"position", {p.x(), p.y(), p.z()}}});
+      json placed = object;
+      placed["position"] = {p.x(), p.y(), p.z()};
+      scene["objects"].push_back(placed);
       const WorldPtr world = f.session.scenes.inline_scene(JsonField(scene, "ball", ""));
       if (check_state(world->sim, ws, f.start) == RolloutStatus::Valid &&
           check_state(world->sim, ws, f.goal) == RolloutStatus::Valid)
         return scene;
     }
   }
-  throw std::runtime_error("no sample of the trajectory leaves start and goal free of the ball");
+  throw std::runtime_error("no sample of the trajectory leaves start and goal free of it");
 }
+
+const json kBall = {{"name", "ball"}, {"type", "sphere"}, {"radius", 0.05}};
 
 TEST(Scenes, AnObstacleGivenAtQueryTimeIsGoneAround) {
   const json open = run_queries("open", {query("open")}).at(0);
   ASSERT_TRUE(open.value("success", false)) << open.dump().substr(0, 600);
   EXPECT_EQ(open["scene"]["name"], "table");
 
-  const json scene = blocked_scene(open, 0.05);
+  const json scene = blocked_scene(open, kBall);
   const std::string scene_file = write_temp_file("scenes/ball.json", scene.dump(2));
   json q = query("blocked");
   q["scene"] = scene_file;
@@ -204,7 +206,7 @@ TEST(Scenes, TheSameSceneFromAFileAndInlineIsOneScene) {
 
 // A, B, A in one process (a query's "scene"), and each in a process of its own (--env).
 TEST(Scenes, SwitchingScenesInOneProcessAnswersAsSeparateProcessesDo) {
-  const json scene_b = blocked_scene(run_queries("probe", {query("probe")}).at(0), 0.05);
+  const json scene_b = blocked_scene(run_queries("probe", {query("probe")}).at(0), kBall);
   const std::string a = source_path("data/environments/table.json");
   const std::string b = write_temp_file("scenes/switch-b.json", scene_b.dump());
   std::vector<json> mixed;
@@ -228,6 +230,45 @@ TEST(Scenes, SwitchingScenesInOneProcessAnswersAsSeparateProcessesDo) {
   }
   EXPECT_NE(together[0]["scene"]["hash"], together[1]["scene"]["hash"]);
   EXPECT_NE(together[0]["edges"], together[1]["edges"]) << "the ball changed nothing";
+}
+
+// The box on the way as a primitive, a mesh, a point cloud and an OctoMap: each plan goes
+// around it, checked against the primitive at every sample.
+TEST(Scenes, TheSameBoxAsAPrimitiveMeshCloudAndOctreeIsGoneAround) {
+  const json open = run_queries("open-box", {query("open-box")}).at(0);
+  ASSERT_TRUE(open.value("success", false));
+  // Placed where a cube 1 cm larger on each side leaves start and goal free: the voxelised
+  // clouds reach up to one cell (1 cm) beyond the box.
+  const json grown = {{"name", "box"}, {"type", "box"}, {"size", {0.08, 0.08, 0.08}}};
+  const json at = blocked_scene(open, grown)["objects"].back()["position"];
+  const BoxFiles box{Eigen::Vector3d(at[0], at[1], at[2]), Eigen::Vector3d::Constant(0.06), 0.01,
+                     "scenes/box"};
+  const std::vector<json> objects = {{{"type", "box"}, {"size", {0.06, 0.06, 0.06}}},
+                               {{"type", "mesh"}, {"file", box.obj()}},
+                               {{"type", "points"}, {"file", box.ply(true)}, {"resolution", 0.01}},
+                               {{"type", "octree"}, {"file", box.bt()}}};
+  std::string primitive_file;
+  for (size_t k = 0; k < objects.size(); ++k) {
+    json object = objects[k];
+    object["name"] = "box";
+    if (k < 2) object["position"] = at;  // the cloud and the map are in base coordinates
+    json scene = table_scene();
+    scene["name"] = "box-" + object["type"].get<std::string>();
+    scene["objects"].push_back(object);
+    const std::string file = write_temp_file("scenes/" + scene["name"].get<std::string>() + ".json",
+                                             scene.dump());
+    if (k == 0) primitive_file = file;
+    json q = query("around");
+    q["scene"] = file;
+    const json r = run_queries("around", {q}).at(0);
+    SCOPED_TRACE(scene["name"].get<std::string>());
+    ASSERT_TRUE(r.value("success", false)) << r.dump().substr(0, 600);
+    const CheckCounts c = check_samples("around", r, primitive_file);
+    EXPECT_GT(c.rows, 0);
+    EXPECT_EQ(c.env_collisions, 0);
+  }
+  EXPECT_GT(check_samples("open-box", open, primitive_file).env_collisions, 0)
+      << "the box is not on the open table's way";
 }
 
 // Through the library: one session, worlds by content, the bundle and indexes shared.

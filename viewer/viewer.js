@@ -216,8 +216,33 @@
           g.merge(new THREE.SphereGeometry(s.radius, 20, 10).translate(0, 0, z));
         return new THREE.Mesh(new THREE.BufferGeometry().fromGeometry(g), material);
       }
+      case 'mesh': {  // an obstacle given as a triangle mesh
+        const g = new THREE.BufferGeometry();
+        g.setAttribute('position', new THREE.Float32BufferAttribute(s.vertices, 3));
+        g.setIndex(s.triangles);
+        g.computeVertexNormals();
+        return new THREE.Mesh(g, material);
+      }
+      case 'cells': return cellsObject(s, material);
       default: throw new Error('unknown shape type ' + s.type + ' (' + s.name + ')');
     }
+  }
+
+  // The occupied cells of an octree obstacle (a voxelised point cloud, an OctoMap): boxes merged
+  // into one geometry, or points (one per cell) when there are too many boxes to draw smoothly.
+  function cellsObject(s, material) {
+    const n = s.sizes.length;
+    if (n > 20000) {
+      const g = new THREE.BufferGeometry();
+      g.setAttribute('position', new THREE.Float32BufferAttribute(s.centres, 3));
+      return new THREE.Points(g, new THREE.PointsMaterial({color: material.color, size: s.sizes[0]}));
+    }
+    const g = new THREE.Geometry();
+    for (let k = 0; k < n; ++k) {
+      const c = s.centres.slice(3 * k, 3 * k + 3);
+      g.merge(new THREE.BoxGeometry(s.sizes[k], s.sizes[k], s.sizes[k]).translate(c[0], c[1], c[2]));
+    }
+    return new THREE.Mesh(new THREE.BufferGeometry().fromGeometry(g), material);
   }
 
   const robot = data.robot;

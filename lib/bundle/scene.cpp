@@ -13,7 +13,11 @@ std::string robot_identity(const RobotModel& robot) {
   return hash_files({robot.config_path, robot.urdf_path});
 }
 
-std::string environment_identity(const Environment& env) { return hash_files({env.path}); }
+std::string environment_identity(const Environment& env) {
+  std::vector<std::string> files = {env.path};  // and what its objects read (meshes, clouds)
+  files.insert(files.end(), env.files.begin(), env.files.end());
+  return hash_files(files);
+}
 
 namespace {
 

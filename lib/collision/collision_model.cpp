@@ -58,6 +58,47 @@ Eigen::Vector3d bounding_half_extents(const Shape& s) {
   return Eigen::Vector3d::Zero();
 }
 
+// A mesh as FCL's bounding volume hierarchy (oriented boxes with swept spheres, for collision
+// and distance alike).
+std::shared_ptr<fcl::CollisionGeometryd> mesh_geometry(const TriangleMesh& mesh) {
+  auto bvh = std::make_shared<fcl::BVHModel<fcl::OBBRSSd>>();
+  std::vector<fcl::Triangle> triangles;
+  triangles.reserve(mesh.triangles.size());
+  for (const Eigen::Vector3i& t : mesh.triangles) triangles.emplace_back(t[0], t[1], t[2]);
+  bvh->beginModel(static_cast<int>(triangles.size()), static_cast<int>(mesh.vertices.size()));
+  bvh->addSubModel(mesh.vertices, triangles);
+  bvh->endModel();
+  bvh->computeLocalAABB();
+  return bvh;
+}
+
+std::shared_ptr<fcl::CollisionGeometryd> obstacle_geometry(const Obstacle& o) {
+  switch (o.type) {
+    case ObstacleType::Mesh:
+      return mesh_geometry(*o.mesh);
+    case ObstacleType::Octree:
+      return std::make_shared<fcl::OcTreed>(o.cells);
+    default:
+      return make_geometry(o.shape, 0);
+  }
+}
+
+// The obstacle's own bounding box, in its frame.
+void local_bounds(const Obstacle& o, Eigen::Vector3d& lower, Eigen::Vector3d& upper) {
+  if (o.type == ObstacleType::Mesh) {
+    lower = upper = o.mesh->vertices.front();
+    for (const Eigen::Vector3d& v : o.mesh->vertices) {
+      lower = lower.cwiseMin(v);
+      upper = upper.cwiseMax(v);
+    }
+  } else if (o.type == ObstacleType::Octree) {
+    occupied_bounds(*o.cells, lower, upper);
+  } else {
+    upper = bounding_half_extents(o.shape);
+    lower = -upper;
+  }
+}
+
 const fcl::CollisionGeometryd* own(CollisionShapes& shapes,
                                    std::shared_ptr<fcl::CollisionGeometryd> geometry) {
   shapes.owned.push_back(std::move(geometry));
@@ -98,10 +139,24 @@ bool narrow_collide(const fcl::CollisionGeometryd* g1, const fcl::Transform3d& t
   return gjk.evaluate(diff, -Eigen::Vector3d::UnitX()) == fcl::detail::GJK<double>::Inside;
 }
 
+// A convex primitive (GJK applies), not a mesh or an octree.
+inline bool is_primitive(const fcl::CollisionGeometryd* g) {
+  return g->getObjectType() == fcl::OT_GEOM;
+}
+
+// A mesh or an octree against a robot shape, through fcl::collide (one contact is enough).
+bool collide_with_bvh(const CollisionData& data, const fcl::CollisionGeometryd* shape,
+                      const fcl::Transform3d& t1, const fcl::CollisionGeometryd* obstacle,
+                      const fcl::Transform3d& t2) {
+  CollisionScratch& s = *data.scratch;
+  s.collision_result.clear();
+  return fcl::collide(shape, t1, obstacle, t2, s.collision_request, s.collision_result) > 0;
+}
+
 double narrow_distance(CollisionData& data, const fcl::CollisionGeometryd* g1,
                        const fcl::Transform3d& t1, const fcl::CollisionGeometryd* g2,
                        const fcl::Transform3d& t2) {
-  if (narrow_collide(g1, t1, g2, t2)) return 0;
+  if (is_primitive(g2) ? narrow_collide(g1, t1, g2, t2) : collide_with_bvh(data, g1, t1, g2, t2)) return 0;
   data.scratch->distance_result.clear();
   const double d =
       fcl::distance(g1, t1, g2, t2, data.scratch->distance_request, data.scratch->distance_result);
@@ -132,6 +187,9 @@ bool env_collides(const CollisionShapes& shapes, const CollisionData& data, int 
   const CollisionShapes::Robot& robot = shapes.robot[a];
   const CollisionShapes::Obstacle& obstacle = shapes.obstacles[o];
   if (!sphere_may_touch_box(data.sphere_centre[a], shapes.env_radius[a], obstacle)) return false;
+  if (!is_primitive(obstacle.geometry))
+    return collide_with_bvh(data, robot.inflated, data.transform[a], obstacle.geometry,
+                            obstacle.transform);
   return narrow_collide(robot.inflated, data.transform[a], obstacle.geometry, obstacle.transform);
 }
 
@@ -166,15 +224,18 @@ CollisionModel build_collision_model(const RobotModel& robot, const Environment&
     s.pose = o.pose;
     s.transform = to_fcl(o.pose);
     // World box around the obstacle's local bounding box (tight for axis-aligned obstacles).
-    const Eigen::Vector3d half = o.pose.R.cwiseAbs() * bounding_half_extents(o.shape);
-    s.box_min = o.pose.p - half;
-    s.box_max = o.pose.p + half;
+    Eigen::Vector3d lower, upper;
+    local_bounds(o, lower, upper);
+    const Eigen::Vector3d centre = o.pose.R * ((lower + upper) / 2) + o.pose.p;
+    const Eigen::Vector3d half = o.pose.R.cwiseAbs() * ((upper - lower) / 2);
+    s.box_min = centre - half;
+    s.box_max = centre + half;
     model.obstacles.push_back(s);
     CollisionShapes::Obstacle g;
     g.box_min = s.box_min;
     g.box_max = s.box_max;
     g.transform = s.transform;
-    g.geometry = own(*shapes, make_geometry(o.shape, 0));
+    g.geometry = own(*shapes, obstacle_geometry(o));
     shapes->obstacles.push_back(g);
   }
   model.shapes = std::move(shapes);

@@ -36,10 +36,13 @@ struct CollisionShapes {
   std::vector<std::shared_ptr<fcl::CollisionGeometryd>> owned;  // keeps the geometry alive
 };
 
-// Per-thread FCL state of the exact-distance queries.
+// Per-thread FCL state of the exact-distance queries, and of the collision queries against
+// meshes and octrees (fcl::collide: their result's contact list keeps its capacity).
 struct CollisionScratch {
   fcl::DistanceRequestd distance_request;
   fcl::DistanceResultd distance_result;
+  fcl::CollisionRequestd collision_request;
+  fcl::CollisionResultd collision_result;
 };
 
 }  // namespace lazyboe

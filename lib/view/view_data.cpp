@@ -1,5 +1,7 @@
 #include "lazyboe/view/view_data.h"
 
+#include <octomap/OcTree.h>
+
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -67,9 +69,46 @@ json robot_view_json(const RobotModel& robot) {
           {"tip", robot.tip_link()}};
 }
 
+namespace {
+
+// A mesh obstacle: its vertices and triangles, flat.
+json mesh_json(const Obstacle& o) {
+  json vertices = json::array(), triangles = json::array();
+  for (const Eigen::Vector3d& v : o.mesh->vertices)
+    for (int c = 0; c < 3; ++c) vertices.push_back(v[c]);
+  for (const Eigen::Vector3i& t : o.mesh->triangles)
+    for (int c = 0; c < 3; ++c) triangles.push_back(t[c]);
+  return {{"name", o.name},         {"type", "mesh"},   {"vertices", vertices},
+          {"triangles", triangles}, {"pose", pose_json(o.pose)}};
+}
+
+// An octree obstacle (a voxelised cloud, an OctoMap): its occupied cells, centres and sizes.
+json cells_json(const Obstacle& o) {
+  json centres = json::array(), sizes = json::array();
+  for (auto it = o.cells->begin_leafs(); it != o.cells->end_leafs(); ++it) {
+    if (!o.cells->isNodeOccupied(*it)) continue;
+    centres.insert(centres.end(), {it.getX(), it.getY(), it.getZ()});
+    sizes.push_back(it.getSize());
+  }
+  return {{"name", o.name},
+          {"type", "cells"},
+          {"centres", centres},
+          {"sizes", sizes},
+          {"pose", pose_json(o.pose)}};
+}
+
+}  // namespace
+
 json environment_view_json(const Environment& env) {
   json obstacles = json::array();
-  for (const Obstacle& o : env.obstacles) obstacles.push_back(shape_json(o.name, o.shape, o.pose));
+  for (const Obstacle& o : env.obstacles) {
+    if (o.type == ObstacleType::Mesh)
+      obstacles.push_back(mesh_json(o));
+    else if (o.type == ObstacleType::Octree)
+      obstacles.push_back(cells_json(o));
+    else
+      obstacles.push_back(shape_json(o.name, o.shape, o.pose));
+  }
   return {{"name", env.name}, {"path", env.path}, {"obstacles", obstacles}};
 }
 
