@@ -4,6 +4,7 @@
 // exact start, with every check (realize_path).
 #pragma once
 
+#include <atomic>
 #include <chrono>
 #include <cstdint>
 #include <limits>
@@ -38,6 +39,10 @@ constexpr double kMaxBudgetSeconds = 1e6;
 struct Termination {
   double budget = 5.0;  // wall-clock seconds, from the start of the solve, (0, kMaxBudgetSeconds]
   bool stop_at_first = false;
+  // Set by the caller (from another thread) to stop the solve early, as a user's Ctrl-C does;
+  // polled with the clock. Null: never.
+  const std::atomic<bool>* cancel = nullptr;
+  bool cancelled() const { return cancel && cancel->load(std::memory_order_relaxed); }
 };
 
 // One planning problem: from `start` (at rest) into the goal region, until `termination`, with

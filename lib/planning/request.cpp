@@ -22,7 +22,10 @@ PlanAnswer answer_request(const PlanningContext& context, const PlanRequest& req
   PlanAnswer a;
   a.raw = request.output.raw;
   a.result = plan(context, ws, request.planner, request.parameters, request.problem, pool);
-  if (!a.result.success) return a;
+  if (!a.result.success) {
+    if (request.problem.termination.cancelled()) a.result.failure = "cancelled";
+    return a;
+  }
   a.trajectory = returned_trajectory(
       context.sim, ws, request.problem, a.result.best_path, a.raw,
       execution_options(context, request.output), returned_sample_every(context.sim, request.output),

@@ -35,7 +35,6 @@ class SearchState {
 
   const PlanningContext& context() const { return ctx_; }
   const PlanningProblem& problem() const { return problem_; }
-  const Deadline& deadline() const { return deadline_; }
   std::vector<SearchNode>& nodes() { return nodes_; }
   SearchNode& node(int v) { return nodes_[v]; }
   PlanResult& result() { return result_; }
@@ -75,8 +74,10 @@ class SearchState {
     }
   }
 
+  // The budget has run out, or the caller cancelled the solve.
+  bool out_of_time() const { return deadline_.passed() || problem_.termination.cancelled(); }
   bool should_stop() const {
-    return deadline_.passed() || (problem_.termination.stop_at_first && result_.success);
+    return out_of_time() || (problem_.termination.stop_at_first && result_.success);
   }
 
  private:

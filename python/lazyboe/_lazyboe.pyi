@@ -101,6 +101,7 @@ class PlanResult:
     duration: Optional[float]
     edges: Optional[npt.NDArray[np.int64]]
     trajectory: Optional[Trajectory]
+    error: Optional[str]
     scene: dict[str, str]
     def to_dict(self) -> dict[str, Any]: ...
 

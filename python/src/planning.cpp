@@ -5,6 +5,8 @@
 #include <pybind11/stl.h>
 
 #include <atomic>
+#include <chrono>
+#include <future>
 #include <exception>
 #include <memory>
 
@@ -28,9 +30,11 @@ struct PyTrajectory {
 struct PyResult {
   Query query;
   PlanAnswer answer;
-  WorldPtr world;  // the scene it was planned in
+  WorldPtr world;     // the scene it was planned in
+  std::string error;  // plan_many: why this query could not be planned (the others were)
 
   nlohmann::json json() const {
+    if (!error.empty()) return error_json(query.id, 0, query.request.planner, error);
     return result_json(query, answer, *world, TrajectoryOutput::Inline, "");
   }
   const PlanResult& result() const { return answer.result; }
@@ -76,7 +80,7 @@ Query read(const Session& s, SimulatorWorkspace& ws, const nlohmann::json& doc,
 }
 
 PyResult answer(const Session& s, SimulatorWorkspace& ws, RolloutPool& pool, const Query& q) {
-  PyResult r{q, {}, q.world ? q.world : s.session->scenes.default_world()};
+  PyResult r{q, {}, q.world ? q.world : s.session->scenes.default_world(), ""};
   r.answer = answer_request(s.session->context(*r.world), q.request, ws, &pool);
   return r;
 }
@@ -103,6 +107,26 @@ nlohmann::json query_doc(const py::object& start, const py::object& goal,
   return doc;
 }
 
+// Runs `work` on a thread of its own while the calling thread, the interpreter's, looks for
+// Ctrl-C every 20 ms; on one it sets `cancel` (the solve stops at its next check) and raises
+// KeyboardInterrupt once the work has returned. Called with the GIL released.
+template <typename Work>
+auto interruptible(std::atomic<bool>& cancel, Work work) -> decltype(work()) {
+  std::future<decltype(work())> done = std::async(std::launch::async, work);
+  std::exception_ptr interrupt;
+  while (done.wait_for(std::chrono::milliseconds(20)) != std::future_status::ready) {
+    if (interrupt) continue;
+    py::gil_scoped_acquire gil;
+    if (PyErr_CheckSignals() != 0) {
+      interrupt = std::make_exception_ptr(py::error_already_set());
+      cancel = true;
+    }
+  }
+  auto result = done.get();
+  if (interrupt) std::rethrow_exception(interrupt);
+  return result;
+}
+
 PyResult plan_one(const Session& s, const py::object& start, const py::object& goal,
                   const std::string& planner, const py::object& budget, const py::object& seed,
                   const std::string& id, const py::object& scene, double sample_interval,
@@ -111,10 +135,14 @@ PyResult plan_one(const Session& s, const py::object& start, const py::object& g
   const QueryDefaults defaults = query_defaults(sample_interval, raw);
   const nlohmann::json doc = query_doc(start, goal, planner, budget, seed, id, scene, params);
   py::gil_scoped_release free;
+  std::atomic<bool> cancel{false};
   SimulatorWorkspace ws(s.session->sim());
-  const Query q = read(s, ws, doc, "", defaults);
-  RolloutPool pool(s.session->sim(), sim_threads);
-  return answer(s, ws, pool, q);
+  Query q = read(s, ws, doc, "", defaults);
+  q.request.problem.termination.cancel = &cancel;
+  return interruptible(cancel, [&] {
+    RolloutPool pool(s.session->sim(), sim_threads);
+    return answer(s, ws, pool, q);
+  });
 }
 
 // Ctrl-C during a batch: the calling thread (OpenMP's thread 0) looks for a pending signal
@@ -135,19 +163,21 @@ struct BatchInterrupt {
   }
 };
 
-// Every query parsed (checked) first, then planned on `jobs` threads; the first error a
-// planner throws is `failure`.
+// Every query parsed (checked) first, then planned on `jobs` threads; a query a planner could
+// not plan (it threw) gets a result with its error, the others are planned. An interrupt
+// cancels the queries in flight too.
 std::vector<PyResult> plan_parsed(const Session& s, const std::vector<nlohmann::json>& docs,
                                   int jobs, const QueryDefaults& defaults,
-                                  BatchInterrupt& interrupt, std::exception_ptr& failure) {
+                                  BatchInterrupt& interrupt) {
   std::vector<Query> parsed;
   {
     SimulatorWorkspace ws(s.session->sim());
-    for (size_t k = 0; k < docs.size(); ++k)
+    for (size_t k = 0; k < docs.size(); ++k) {
       parsed.push_back(read(s, ws, docs[k], "queries[" + std::to_string(k) + "]", defaults));
+      parsed.back().request.problem.termination.cancel = &interrupt.seen;
+    }
   }
   std::vector<PyResult> results(parsed.size());
-  std::vector<std::exception_ptr> errors(parsed.size());
 #pragma omp parallel num_threads(jobs)
   {
     SimulatorWorkspace ws(s.session->sim());
@@ -157,13 +187,11 @@ std::vector<PyResult> plan_parsed(const Session& s, const std::vector<nlohmann::
       if (interrupt.check()) continue;
       try {
         results[k] = answer(s, ws, pool, parsed[k]);
-      } catch (...) {
-        errors[k] = std::current_exception();
+      } catch (const std::exception& e) {
+        results[k] = PyResult{parsed[k], {}, s.session->scenes.default_world(), e.what()};
       }
     }
   }
-  for (const std::exception_ptr& e : errors)
-    if (e && !failure) failure = e;
   return results;
 }
 
@@ -181,14 +209,12 @@ std::vector<PyResult> plan_many(const Session& s, const py::iterable& queries, i
     docs.push_back(std::move(doc));
   }
   BatchInterrupt interrupt;
-  std::exception_ptr failure;
   std::vector<PyResult> results;
   {
     py::gil_scoped_release free;
-    results = plan_parsed(s, docs, jobs, defaults, interrupt, failure);
+    results = plan_parsed(s, docs, jobs, defaults, interrupt);
   }
   if (interrupt.error) std::rethrow_exception(interrupt.error);
-  if (failure) std::rethrow_exception(failure);
   return results;
 }
 
@@ -284,6 +310,7 @@ void bind_result(py::module_& m) {
       .def_property_readonly(
           "failure",
           [](const PyResult& r) -> py::object {
+            if (!r.error.empty()) return py::str("error: " + r.error);
             return r.result().success ? py::object(py::none()) : py::str(r.result().failure);
           },
           "Why there is no solution; None with one.")
@@ -314,6 +341,13 @@ void bind_result(py::module_& m) {
           },
           "The trajectory (t, q, dq, ddq, cmd, edges, cost, duration, stops): the executable one, "
           "or the raw chain with raw=True; None without a solution.")
+      .def_property_readonly(
+          "error",
+          [](const PyResult& r) -> py::object {
+            return r.error.empty() ? py::object(py::none()) : py::str(r.error);
+          },
+          "plan_many: why this query could not be planned (the planner failed: the others "
+          "were planned); None otherwise.")
       .def_property_readonly(
           "scene",
           [](const PyResult& r) {
@@ -377,13 +411,16 @@ void bind_planning(py::module_& m) {
            "tick); sim_threads: threads simulating one query's edges (the answer does not depend "
            "on it); raw: the planner's edge chain with a stop at every junction (lazyboe-query "
            "--raw) instead of the executable trajectory (blended, shortcut). ValueError "
-           "(with the field's name) for a bad query; returns a PlanResult.")
+           "(with the field's name) for a bad query; returns a PlanResult. Ctrl-C stops the "
+           "solve at its next check and raises KeyboardInterrupt.")
       .def("plan_many", &plan_many, py::arg("queries"), py::arg("jobs") = 0,
            py::arg("sample_interval") = 0.01, py::arg("raw") = false,
            "Plans a batch of queries (dicts in the query format: start, goal, planner, budget, "
            "seed, parameters; id optional) on `jobs` threads (0: all cores); results in input "
-           "order. Every query is checked before any is planned. Ctrl-C stops the batch "
-           "after the queries in flight (KeyboardInterrupt).")
+           "order. Every query is checked before any is planned (ValueError naming the first bad "
+           "one); a query whose planner fails (RuntimeError from plan()) gets a result with its "
+           "`error`, and the others are planned. Ctrl-C cancels the queries in flight and "
+           "raises KeyboardInterrupt.")
       .def_property_readonly(
           "robot",
           [](const Session& s) {

@@ -261,3 +261,29 @@ def test_ctrl_c_stops_a_batch(session):
         session.plan_many(qs, jobs=2)
     timer.join()
     assert time.monotonic() - start < 5
+
+
+def test_ctrl_c_stops_one_plan(session):
+    """SIGINT during a single plan() of a 30 s budget stops it at the planner's next check."""
+    timer = threading.Timer(0.3, os.kill, (os.getpid(), signal.SIGINT))
+    start = time.monotonic()
+    timer.start()
+    with pytest.raises(KeyboardInterrupt):
+        session.plan(START, {"q": GOAL, "tolerance": 0.1}, planner="lazyboe", budget=30, seed=1)
+    timer.join()
+    assert time.monotonic() - start < 2
+
+
+def test_plan_many_gives_an_error_result_for_a_planner_that_fails(unperturbed_path):
+    """lazyboe needs the perturbation analysis: its query gets an error, the others are planned."""
+    s = lazyboe.PlanningSession(unperturbed_path)
+    results = s.plan_many([query({"id": "a", "planner": "boe", "seed": 3}),
+                           query({"id": "b", "planner": "lazyboe"}),
+                           query({"id": "c", "planner": "rrt", "seed": 2})], jobs=2)
+    assert [r.id for r in results] == ["a", "b", "c"]
+    assert results[0].success and results[2].success
+    assert not results[1].success
+    assert "perturbation" in results[1].error
+    assert results[1].failure.startswith("error: ")
+    assert results[1].to_dict()["error"] == results[1].error
+    assert results[0].error is None

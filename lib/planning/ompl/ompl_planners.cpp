@@ -549,9 +549,10 @@ PlanResult solve_with_ompl(const std::string& name, const ParameterValues& value
   planner->setProblemDefinition(pdef);
   planner->setup();
 
-  const double budget = search.problem.termination.budget;
-  const ob::PlannerTerminationCondition ptc =
-      ob::timedPlannerTerminationCondition(std::max(0.0, budget - search.elapsed()));
+  const Termination& termination = search.problem.termination;
+  const ob::PlannerTerminationCondition ptc = ob::plannerOrTerminationCondition(
+      ob::timedPlannerTerminationCondition(std::max(0.0, termination.budget - search.elapsed())),
+      ob::PlannerTerminationCondition([&termination] { return termination.cancelled(); }));
   const ob::PlannerStatus status = planner->solve(ptc);
 
   PlanResult result;

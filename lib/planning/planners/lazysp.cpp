@@ -170,7 +170,7 @@ int LazySpSearch::search(size_t& expansions) {
     push(x, n.h);
   }
   while (!open_.empty() && expansions < set_.expansion_limit) {
-    if (expansions % 64 == 0 && s_.deadline().passed()) return -1;
+    if (expansions % 8 == 0 && s_.out_of_time()) return -1;
     const int p = open_.top().second;
     open_.pop();
     if (best_in_cell_[preds_[p].cell] < preds_[p].g) continue;  // superseded in its cell
@@ -236,7 +236,7 @@ void LazySpSearch::validate(int goal) {
   std::reverse(chain.begin(), chain.end());
   int r = preds_[u].real;
   for (const int p : chain) {
-    if (s_.deadline().passed()) return;
+    if (s_.out_of_time()) return;
     const uint32_t e = preds_[p].edge;
     tried_.insert(key(r, e));
     const RolloutResult res = s_.simulate_from(s_.node(r).q, bundle_.command(e));
