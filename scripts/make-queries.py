@@ -11,14 +11,15 @@ prints the share of candidate pairs that were blocked.
 """
 import argparse, csv, json, math, os, random, subprocess, sys, tempfile
 
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))  # defaults from any folder
 p = argparse.ArgumentParser()
 p.add_argument("out"); p.add_argument("count", type=int); p.add_argument("seed", type=int)
-p.add_argument("--env", default="data/environments/table.json")
+p.add_argument("--env", default=os.path.join(ROOT, "data/environments/table.json"))
 p.add_argument("--tolerance", type=float, default=0.3)
 p.add_argument("--budget", type=float, default=2.0)
 p.add_argument("--planners", default="lazyboe,boe,rrt,sst")
-p.add_argument("--tool", default="build/bin/lazyboe-robot")
-p.add_argument("--robot", default="data/robots/panda.json")
+p.add_argument("--tool", default=os.path.join(ROOT, "build/bin/lazyboe-robot"))
+p.add_argument("--robot", default=os.path.join(ROOT, "data/robots/panda.json"))
 p.add_argument("--blocked", action="store_true",
                help="only pairs whose straight joint-space line collides in the scene")
 p.add_argument("--min-separation", type=float, default=0.0,
@@ -36,8 +37,8 @@ else:
 rng = random.Random(a.seed)
 
 
-def check(configs):
-    """lazyboe-robot check of each configuration: True where it is free (with 3 cm clearance)."""
+def check(configs, clearance=0.03):
+    """lazyboe-robot check of each configuration: True where it is free (with `clearance`, m)."""
     with tempfile.TemporaryDirectory() as d:
         inp, res = os.path.join(d, "in.csv"), os.path.join(d, "out.csv")
         with open(inp, "w") as f:
@@ -47,13 +48,13 @@ def check(configs):
                        check=True, stderr=subprocess.DEVNULL)
         rows = list(csv.DictReader(open(res)))
     return [r["in_limits"] == "1" and r["self_collision"] == "0" and r["env_collision"] == "0"
-            and float(r["min_distance"]) > 0.03 for r in rows]
+            and float(r["min_distance"]) > clearance for r in rows]
 
 
 def line_blocked(s, g):
     n = max(2, int(math.dist(s, g) / 0.02) + 1)
     line = [[s[i] + (g[i] - s[i]) * k / n for i in range(len(s))] for k in range(1, n)]
-    return not all(check(line))
+    return not all(check(line, clearance=-1))  # a collision (at the robot's margin), not 3 cm
 
 
 cand = [[round(rng.uniform(l, h), 4) for l, h in zip(lo, hi)] for _ in range(40 * a.count)]

@@ -64,7 +64,7 @@ std::vector<std::string> files_in(const std::string& dir) {
   return out;
 }
 
-// Temporary files of the crash-safe writer ("<path>.tmp.<pid>").
+// Temporary files of the crash-safe writer ("<path>.tmp.<pid>.<n>").
 std::vector<std::string> tmp_files_in(const std::string& dir) {
   std::vector<std::string> out;
   for (const std::string& f : files_in(dir)) {

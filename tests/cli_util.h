@@ -40,7 +40,7 @@ std::string fresh_dir(const std::string& name);
 
 std::vector<std::string> files_in(const std::string& dir);
 
-// Temporary files of the crash-safe writer ("<path>.tmp.<pid>").
+// Temporary files of the crash-safe writer ("<path>.tmp.<pid>.<n>").
 std::vector<std::string> tmp_files_in(const std::string& dir);
 
 // Every file of a directory with its bytes.

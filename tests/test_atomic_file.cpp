@@ -61,11 +61,23 @@ std::string error_of(const std::function<void()>& f) {
   return "(no error)";
 }
 
-TEST_F(AtomicFileTest, TemporaryNameIsPathDotTmpDotPid) {
+TEST_F(AtomicFileTest, TemporaryNameIsPathDotTmpDotPidDotWriter) {
   AtomicFile file(path("out.txt"));
   EXPECT_EQ(file.path(), path("out.txt"));
-  EXPECT_EQ(file.temp_path(), path("out.txt") + ".tmp." + std::to_string(::getpid()));
+  const std::string prefix = path("out.txt") + ".tmp." + std::to_string(::getpid()) + ".";
+  EXPECT_EQ(file.temp_path().rfind(prefix, 0), 0u) << file.temp_path();
   EXPECT_TRUE(fs::exists(file.temp_path()));
+}
+
+TEST_F(AtomicFileTest, TwoWritersOfOnePathHaveTheirOwnTemporaries) {
+  AtomicFile first(path("out.txt")), second(path("out.txt"));
+  EXPECT_NE(first.temp_path(), second.temp_path());
+  first.stream() << "first\n";
+  second.stream() << "second\n";
+  first.commit();
+  EXPECT_EQ(read_text(path("out.txt")), "first\n");
+  second.commit();  // its content is its own, not the first's
+  EXPECT_EQ(read_text(path("out.txt")), "second\n");
 }
 
 TEST_F(AtomicFileTest, CommitReplacesTheFile) {

@@ -298,11 +298,11 @@ TEST(BuildCli, InterruptedBuildResumesToTheStraightBuild) {
 void check_killed_build(const std::string& dir, const std::string& out, pid_t killed_pid,
                         bool must_exist) {
   const std::string own_tmp =
-      fs::path(out).filename().string() + ".tmp." + std::to_string(killed_pid);
+      fs::path(out).filename().string() + ".tmp." + std::to_string(killed_pid) + ".";
   auto unexpected_tmp = [&] {
     std::vector<std::string> bad;
     for (const std::string& f : tmp_files_in(dir)) {
-      if (f != own_tmp) bad.push_back(f);
+      if (f.rfind(own_tmp, 0) != 0) bad.push_back(f);
     }
     return bad;
   };

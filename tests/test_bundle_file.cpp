@@ -18,6 +18,7 @@
 #include <thread>
 
 #include "lazyboe/bundle/bundle_file.h"
+#include "lazyboe/common/atomic_file.h"
 #include "lazyboe/bundle/bundle_view.h"
 #include "lazyboe/bundle/hdf5_handle.h"
 #include "lazyboe/common/error.h"
@@ -274,7 +275,7 @@ TEST(BundleFile, FailedWriteKeepsTheOldFile) {
   EXPECT_TRUE(others_in_dir(path).empty());
 
   // A failure after the temporary file is under way: something is in the way of its name.
-  const std::string tmp = path + ".tmp." + std::to_string(::getpid());
+  const std::string tmp = next_temporary_name(path);
   fs::create_directory(tmp);
   expect_error(error_of([&] { write_bundle(path, random_bundle(40, 7, 4)); }), path,
                {"cannot write", "Is a directory"});

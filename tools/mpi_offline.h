@@ -16,11 +16,13 @@
 
 namespace lazyboe::mpi {
 
-// Launched by mpirun / srun (their environment variables), and the world size they announce.
+// Launched by mpirun or srun (the variables their process managers set for each rank), and
+// the world size they announce. Not SLURM_NTASKS: every process of a Slurm job has it, ranks
+// started by srun or not.
 inline int launcher_world_size() {
-  for (const char* name : {"OMPI_COMM_WORLD_SIZE", "PMIX_SIZE", "PMI_SIZE", "SLURM_NTASKS"}) {
+  for (const char* name : {"OMPI_COMM_WORLD_SIZE", "PMIX_SIZE", "PMI_SIZE"}) {
     const char* v = std::getenv(name);
-    if (v && std::atoi(v) > 0 && std::string(name) != "SLURM_NTASKS") return std::atoi(v);
+    if (v && std::atoi(v) > 0) return std::atoi(v);
   }
   return 0;
 }

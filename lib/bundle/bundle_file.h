@@ -48,7 +48,7 @@ constexpr const char* p_lazy_prop_transfer = "/perturbation/p_lazy_prop_transfer
 // Error("<where>: bundle.<field>: ...").
 void check_bundle(const Bundle& bundle, const std::string& where);
 
-// Writes the whole bundle (check_bundle first) to "<path>.tmp.<pid>", flushes and fsyncs it,
+// Writes the whole bundle (check_bundle first) to "<path>.tmp.<pid>.<n>", flushes and fsyncs it,
 // then renames it over `path`. On failure the temporary file is removed, `path` is untouched,
 // and Error is thrown. (A process killed mid-write may leave its temporary file behind.)
 void write_bundle(const std::string& path, const Bundle& bundle);

@@ -1,5 +1,7 @@
 #include "lazyboe/common/atomic_file.h"
 
+#include <atomic>
+
 #include <fcntl.h>
 #include <unistd.h>
 
@@ -27,10 +29,22 @@ void fsync_path(const std::string& path, bool directory) {
   if (rc != 0) fail(path, "cannot sync to disk: " + std::string(std::strerror(err)));
 }
 
+// "<path>.tmp.<pid>.<n>": n counts the writers of this process, so two writers of one path
+// (two threads, two sessions) never share a temporary.
+std::atomic<uint64_t> writers{0};
+
+std::string temporary_name(const std::string& path, uint64_t writer) {
+  return path + ".tmp." + std::to_string(::getpid()) + "." + std::to_string(writer);
+}
+
 }  // namespace
 
+std::string next_temporary_name(const std::string& path) {
+  return temporary_name(path, writers.load());
+}
+
 AtomicFile::AtomicFile(const std::string& path, Writer writer)
-    : path_(path), temp_path_(path + ".tmp." + std::to_string(::getpid())) {
+    : path_(path), temp_path_(temporary_name(path, writers++)) {
   // Said now, not after all the work when the rename fails.
   std::error_code error;  // an unreadable path is refused by the open or the rename, clearly
   if (std::filesystem::is_directory(path_, error))

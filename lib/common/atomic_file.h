@@ -1,4 +1,4 @@
-// A file written all at once or not at all: the content goes to "<path>.tmp.<pid>" in the same
+// A file written all at once or not at all: the content goes to "<path>.tmp.<pid>.<n>" in the same
 // directory, and commit() renames it over `path`. Until then `path` keeps its old content (or
 // stays absent); a writer that throws or returns early leaves no temporary file behind (only a
 // killed process may).
@@ -9,6 +9,10 @@
 #include <string>
 
 namespace lazyboe {
+
+// The temporary name the next AtomicFile made in this process will write `path` under (while no
+// other thread makes one): for tests that put something in its way.
+std::string next_temporary_name(const std::string& path);
 
 class AtomicFile {
  public:

@@ -24,12 +24,12 @@ namespace lazyboe {
 // theta of the bundle's perturbation analysis, or its design theta without one.
 double bundle_theta(const BundleView& bundle);
 
-// The planning context of a bundle, for any holder of one (a session, a test, a front end):
-// the simulator, the bundle and its indexes, its mean edge displacement, and from the bundle's
-// header its theta, sampling box and command family.
 // Mean joint-space displacement |qf - q0| of the bundle's edges, rad (0 for an empty bundle).
 double mean_edge_displacement(const BundleView& bundle);
 
+// The planning context of a bundle, for any holder of one (a session, a test, a front end):
+// the simulator (of the world planned in), the bundle and its indexes, its mean edge
+// displacement, and from the bundle's header its theta, sampling box and command family.
 PlanningContext bundle_context(const Simulator& sim, const BundleView& bundle,
                                const EdgeIndex& index, const EdgeIndex* end_index = nullptr);
 // The same with the mean edge displacement known (it reads every edge state to compute).

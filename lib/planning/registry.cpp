@@ -107,6 +107,8 @@ const char* type_name(ParameterType t) {
       return "integer";
     case ParameterType::Boolean:
       return "boolean";
+    case ParameterType::Choice:
+      return "choice";
     default:
       return "real";
   }

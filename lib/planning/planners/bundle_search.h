@@ -106,8 +106,9 @@ double bundle_planner_setup(const PlanningContext& context, const ParameterValue
 bool edge_ends_near(const PlanningContext& context, const JointVectorRef& q, double radius,
                     std::vector<std::pair<uint32_t, double>>& scratch);
 
-// A bundle planner: Search (BundleSearch or a subclass) with theta from its parameters or the
-// context.
+// A bundle planner: Search (BundleSearch or a subclass, or lazysp's LazySpSearch: any search made
+// from the context, workspace, problem, theta, pool and values) with theta from its parameters
+// or the context.
 template <class Search>
 class BundlePlanner : public Planner {
  public:
