@@ -144,8 +144,9 @@ inline bool is_primitive(const fcl::CollisionGeometryd* g) {
   return g->getObjectType() == fcl::OT_GEOM;
 }
 
-// A mesh or an octree against a robot shape, through fcl::collide (one contact is enough).
-bool collide_with_bvh(const CollisionData& data, const fcl::CollisionGeometryd* shape,
+// A mesh or an octree against a robot shape, through fcl::collide (one contact is enough). Kept
+// out of line: inlined, its setup would weigh on every culled pair of the primitives' path.
+[[gnu::noinline]] bool collide_with_bvh(const CollisionData& data, const fcl::CollisionGeometryd* shape,
                       const fcl::Transform3d& t1, const fcl::CollisionGeometryd* obstacle,
                       const fcl::Transform3d& t2) {
   CollisionScratch& s = *data.scratch;
@@ -187,7 +188,7 @@ bool env_collides(const CollisionShapes& shapes, const CollisionData& data, int 
   const CollisionShapes::Robot& robot = shapes.robot[a];
   const CollisionShapes::Obstacle& obstacle = shapes.obstacles[o];
   if (!sphere_may_touch_box(data.sphere_centre[a], shapes.env_radius[a], obstacle)) return false;
-  if (!is_primitive(obstacle.geometry))
+  if (!obstacle.primitive)
     return collide_with_bvh(data, robot.inflated, data.transform[a], obstacle.geometry,
                             obstacle.transform);
   return narrow_collide(robot.inflated, data.transform[a], obstacle.geometry, obstacle.transform);
@@ -236,6 +237,7 @@ CollisionModel build_collision_model(const RobotModel& robot, const Environment&
     g.box_max = s.box_max;
     g.transform = s.transform;
     g.geometry = own(*shapes, obstacle_geometry(o));
+    g.primitive = is_primitive(g.geometry);
     shapes->obstacles.push_back(g);
   }
   model.shapes = std::move(shapes);

@@ -26,8 +26,10 @@ struct CollisionShapes {
     Eigen::Vector3d box_min;     // CollisionModel::ObstacleShape's bounding box
     const fcl::CollisionGeometryd* geometry = nullptr;
     Eigen::Vector3d box_max;
+    bool primitive = true;       // a convex primitive (GJK), not a mesh or an octree
     fcl::Transform3d transform;  // in the base frame
   };
+  static_assert(sizeof(Obstacle) == 192, "an obstacle's record stays three cache lines");
   double margin = 0;  // CollisionModel::margin
   std::vector<Robot> robot;
   std::vector<double> env_radius;             // sphere_radius + margin, per robot shape

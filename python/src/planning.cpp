@@ -259,7 +259,7 @@ py::list planners() {
   return out;
 }
 
-void bind_result(py::module_& m) {
+void bind_trajectory(py::module_& m) {
   py::class_<PyTrajectory>(m, "Trajectory",
                            "A realized trajectory: the path simulated again from the exact start "
                            "with every check.")
@@ -278,11 +278,37 @@ void bind_result(py::module_& m) {
       .def_readonly("cost", &PyTrajectory::cost, "Joint-space arc length, rad.")
       .def_readonly("duration", &PyTrajectory::duration, "s.")
       .def("__len__", [](const PyTrajectory& t) { return t.t.size(); });
+}
 
+// {'name', 'hash'}: a scene as results name it.
+py::dict scene_dict(const Environment& env) {
+  return py::dict(py::arg("name") = env.name, py::arg("hash") = env.identity);
+}
+
+// The PlanResult properties that say where and how it was answered (beside the result line's).
+void bind_result_extras(py::class_<PyResult>& c) {
+  c.def_property_readonly(
+       "error",
+       [](const PyResult& r) -> py::object {
+         return r.error.empty() ? py::object(py::none()) : py::str(r.error);
+       },
+       "plan_many: why this query could not be planned (the planner failed: the others "
+       "were planned); None otherwise.")
+      .def_property_readonly(
+          "scene",
+          [](const PyResult& r) { return scene_dict(r.world->env); },
+          "The scene it was planned in: {'name', 'hash'}.");
+}
+
+void bind_result(py::module_& m) {
+  bind_trajectory(m);
   auto opt = [](bool present, double v) -> py::object {
     return present ? py::object(py::float_(v)) : py::object(py::none());
   };
-  py::class_<PyResult>(m, "PlanResult", "The answer to one query, with the result line's names.")
+  py::class_<PyResult> result(m, "PlanResult",
+                              "The answer to one query, with the result line's names.");
+  bind_result_extras(result);
+  result
       .def_property_readonly(
           "id", [](const PyResult& r) { return r.query.id; }, "The query id.")
       .def_property_readonly(
@@ -341,20 +367,6 @@ void bind_result(py::module_& m) {
           },
           "The trajectory (t, q, dq, ddq, cmd, edges, cost, duration, stops): the executable one, "
           "or the raw chain with raw=True; None without a solution.")
-      .def_property_readonly(
-          "error",
-          [](const PyResult& r) -> py::object {
-            return r.error.empty() ? py::object(py::none()) : py::str(r.error);
-          },
-          "plan_many: why this query could not be planned (the planner failed: the others "
-          "were planned); None otherwise.")
-      .def_property_readonly(
-          "scene",
-          [](const PyResult& r) {
-            return py::dict(py::arg("name") = r.world->env.name,
-                            py::arg("hash") = r.world->env.identity);
-          },
-          "The scene it was planned in: {'name', 'hash'}.")
       .def(
           "to_dict", [](const PyResult& r) { return from_json(r.json()); },
           "The result line of lazyboe-query --trajectories inline, as a dict.")
@@ -370,15 +382,51 @@ void bind_result(py::module_& m) {
 
 py::object make_bundle_object(std::shared_ptr<const BundleView> view);
 
+namespace {
+
+// What a PlanningSession holds, read-only.
+void bind_session_properties(py::class_<Session>& c) {
+  c.def_property_readonly(
+          "robot",
+          [](const Session& s) {
+            return PyRobot{std::shared_ptr<const RobotModel>(s.session, &s.session->robot)};
+          },
+          "The bundle's robot (a lazyboe.Robot).")
+      .def_property_readonly(
+          "bundle",
+          [](const Session& s) {
+            return make_bundle_object(
+                std::shared_ptr<const BundleView>(s.session, &s.session->bundle));
+          },
+          "The bundle (a lazyboe.Bundle sharing the session's mapping).")
+      .def_property_readonly(
+          "scene",
+          [](const Session& s) { return scene_dict(s.session->world().env); },
+          "The default scene planned in: {'name', 'hash'} (the content hash results carry).")
+      .def_property_readonly(
+          "load_seconds", [](const Session& s) { return s.session->load_seconds; },
+          "Wall time of opening the session, s.")
+      .def_property_readonly(
+          "index_source", [](const Session& s) { return s.session->indexes.source; },
+          "Where the k-d trees came from: 'mapped from <bundle>.kd-index', 'read from ...' "
+          "(memory_map=False), or 'built at load (why)'.")
+      .def_property_readonly(
+          "default_theta", [](const Session& s) { return s.session->default_theta(); },
+          "theta of the bundle's perturbation analysis (or its design theta).");
+}
+
+}  // namespace
+
 void bind_planning(py::module_& m) {
   bind_result(m);
   m.def("planners", &planners,
         "The planner registry: per planner its name, description, needs, availability in this "
         "build, and parameters (type, default, range, description).");
-  py::class_<Session>(m, "PlanningSession",
-                      "A bundle opened once for planning (memory-mapped), with its robot, "
-                      "environment, simulator and neighbour indexes. Thread-safe: plan() "
-                      "releases the GIL, so Python threads plan in parallel.")
+  py::class_<Session> session(m, "PlanningSession",
+                              "A bundle opened once for planning (memory-mapped), with its robot, "
+                              "neighbour indexes and the scenes it plans in. Thread-safe: plan() "
+                              "releases the GIL, so Python threads plan in parallel.");
+  session
       .def(py::init([](const py::object& path, bool memory_map, const py::object& robot,
                        const py::object& env) {
              const std::string p = py::str(path).cast<std::string>();
@@ -420,37 +468,8 @@ void bind_planning(py::module_& m) {
            "order. Every query is checked before any is planned (ValueError naming the first bad "
            "one); a query whose planner fails (RuntimeError from plan()) gets a result with its "
            "`error`, and the others are planned. Ctrl-C cancels the queries in flight and "
-           "raises KeyboardInterrupt.")
-      .def_property_readonly(
-          "robot",
-          [](const Session& s) {
-            return PyRobot{std::shared_ptr<const RobotModel>(s.session, &s.session->robot)};
-          },
-          "The bundle's robot (a lazyboe.Robot).")
-      .def_property_readonly(
-          "bundle",
-          [](const Session& s) {
-            return make_bundle_object(
-                std::shared_ptr<const BundleView>(s.session, &s.session->bundle));
-          },
-          "The bundle (a lazyboe.Bundle sharing the session's mapping).")
-      .def_property_readonly(
-          "scene",
-          [](const Session& s) {
-            const Environment& env = s.session->world().env;
-            return py::dict(py::arg("name") = env.name, py::arg("hash") = env.identity);
-          },
-          "The default scene planned in: {'name', 'hash'} (the content hash results carry).")
-      .def_property_readonly(
-          "load_seconds", [](const Session& s) { return s.session->load_seconds; },
-          "Wall time of opening the session, s.")
-      .def_property_readonly(
-          "index_source", [](const Session& s) { return s.session->indexes.source; },
-          "Where the k-d trees came from: 'mapped from <bundle>.kd-index', 'read from ...' "
-          "(memory_map=False), or 'built at load (why)'.")
-      .def_property_readonly(
-          "default_theta", [](const Session& s) { return s.session->default_theta(); },
-          "theta of the bundle's perturbation analysis (or its design theta).");
+           "raises KeyboardInterrupt.");
+  bind_session_properties(session);
 }
 
 }  // namespace lazyboe::python
