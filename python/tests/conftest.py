@@ -26,6 +26,15 @@ def tool(name, *args, **kwargs):
                           text=True, **kwargs)
 
 
+def without_timings(d):
+    """A result line without its wall times (and line number), which no two runs share."""
+    d.pop("time_to_first_solution")
+    d.pop("line", None)
+    for timing in ("seconds", "raw_seconds"):
+        d.get("post_processing", {}).pop(timing, None)
+    return d
+
+
 def empty_env():
     return SOURCE / "data" / "environments" / "empty.json"
 

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import lazyboe
-from conftest import GOAL, START, tool
+from conftest import GOAL, START, tool, without_timings
 
 # Queries every planner family answers deterministically (stop_at_first, generous budget).
 QUERIES = [
@@ -49,15 +49,6 @@ def tool_results(bundle_path, tmp_path_factory):
 @pytest.fixture(scope="module")
 def tool_raw_results(bundle_path, tmp_path_factory):
     return run_tool(bundle_path, tmp_path_factory, "--raw")
-
-
-def without_timings(d):
-    """A result line without its wall times (and line number), which no two runs share."""
-    d.pop("time_to_first_solution")
-    d.pop("line", None)
-    for timing in ("seconds", "raw_seconds"):
-        d.get("post_processing", {}).pop(timing, None)
-    return d
 
 
 def same_as_tool(result, line):

@@ -5,7 +5,7 @@ import json
 import pytest
 
 import lazyboe
-from conftest import GOAL, SOURCE, START, empty_env, tool
+from conftest import GOAL, SOURCE, START, empty_env, tool, without_timings
 
 TABLE = SOURCE / "data" / "environments" / "table.json"
 
@@ -13,14 +13,6 @@ TABLE = SOURCE / "data" / "environments" / "table.json"
 def plan(session, **kwargs):
     return session.plan(START, {"q": GOAL, "tolerance": 0.1}, planner="boe", seed=3, budget=20,
                         stop_at_first=True, **kwargs)
-
-
-def without_timings(d):
-    d.pop("time_to_first_solution")
-    d.pop("line", None)
-    for timing in ("seconds", "raw_seconds"):
-        d.get("post_processing", {}).pop(timing, None)
-    return d
 
 
 def test_a_scene_by_path_and_inline_is_one_scene(session):
