@@ -46,7 +46,17 @@ if ok:
           "stops for the raw edge chains (lazyboe-query --raw)")
 PY
 echo
-echo "== 5. Viewer: robot, table, the trajectories above and a sample of the bundle, in 3-D"
+echo "== 5. The same bundle in a scene it was not built in: a random cluttered table (make-scene.py clutter 7)"
+# Any scene of the robot, given at query time: only collisions change, and every returned edge
+# is simulated again in the query's scene. Problems whose straight joint-space line collides.
+python3 scripts/make-scene.py clutter 7 "$out/clutter.json"
+python3 scripts/make-queries.py "$out/clutter-queries.jsonl" 4 7 --env "$out/clutter.json" \
+  --blocked --min-separation 0.6 --planners lazysp,rrt --budget 2 --tool "$bin/lazyboe-robot"
+"$bin/lazyboe-query" --bundle "$out/bundle.h5" --queries "$out/clutter-queries.jsonl" \
+  --env "$out/clutter.json" --out "$out/clutter-results.jsonl" --jobs 2
+echo "   results: $out/clutter-results.jsonl (each says \"scene\": {\"name\": \"clutter-7\", ...})"
+echo
+echo "== 6. Viewer: robot, table, the trajectories above and a sample of the bundle, in 3-D"
 "$bin/lazyboe-view" --results "$out/results.jsonl" --queries data/queries/table-demo.jsonl \
   --bundle "$out/bundle.h5" --bundle-points 4000 --title "LazyBoE demo: table.json" --out "$out/view.html"
 echo "   open in a browser (one self-contained file): $(realpath "$out/view.html")"
