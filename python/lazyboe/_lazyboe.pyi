@@ -105,6 +105,11 @@ class PlanResult:
     scene: dict[str, str]
     def to_dict(self) -> dict[str, Any]: ...
 
+class Scene:
+    name: str
+    hash: str
+    obstacles: list[str]
+
 class PlanningSession:
     robot: Robot
     bundle: Bundle
@@ -116,8 +121,9 @@ class PlanningSession:
                  env: Optional[Path] = None) -> None: ...
     def plan(self, start: ArrayLike, goal: dict[str, Any], planner: str = "lazyboe",
              budget: Optional[float] = None, seed: Optional[int] = None, id: str = "",
-             scene: Union[Path, dict[str, Any], None] = None, sample_interval: float = 0.01, sim_threads: int = 1, raw: bool = False,
+             scene: Union[Scene, Path, dict[str, Any], None] = None, sample_interval: float = 0.01, sim_threads: int = 1, raw: bool = False,
              **params: Any) -> PlanResult: ...
+    def load_scene(self, env: Union[Path, dict[str, Any]]) -> Scene: ...
     def plan_many(self, queries: Iterable[dict[str, Any]], jobs: int = 0,
                   sample_interval: float = 0.01, raw: bool = False) -> list[PlanResult]: ...
 

@@ -60,6 +60,11 @@ struct Session {
   std::shared_ptr<const PlanningSession> session;
 };
 
+// A scene loaded once (PlanningSession.load_scene): its world, ready for any number of plans.
+struct PyScene {
+  WorldPtr world;
+};
+
 // What to return, as lazyboe-query's flags say it.
 QueryDefaults query_defaults(double sample_interval, bool raw) {
   if (!(sample_interval > 0)) throw InputError("sample_interval: must be > 0");
@@ -70,10 +75,13 @@ QueryDefaults query_defaults(double sample_interval, bool raw) {
 }
 
 // `where` starts the errors: "" (plan: the field alone) or "queries[2]".
+// `world`: where the problem is checked when the query names no scene (default: the session's).
 Query read(const Session& s, SimulatorWorkspace& ws, const nlohmann::json& doc,
-           const std::string& where, const QueryDefaults& defaults) {
+           const std::string& where, const QueryDefaults& defaults,
+           const WorldPtr& world = nullptr) {
   try {
-    return read_query(doc, where, s.session->sim(), ws, defaults, &s.session->scenes);
+    return read_query(doc, where, world ? world->sim : s.session->sim(), ws, defaults,
+                      &s.session->scenes);
   } catch (const Error& e) {
     throw InputError(e.what());
   }
@@ -98,7 +106,7 @@ nlohmann::json query_doc(const py::object& start, const py::object& goal,
   if (!seed.is_none()) doc["seed"] = to_json(seed, "seed");
   if (py::isinstance<py::dict>(scene))
     doc["scene"] = to_json(scene, "scene");
-  else if (!scene.is_none())
+  else if (!scene.is_none() && !py::isinstance<PyScene>(scene))
     doc["scene"] = py::str(scene).cast<std::string>();  // a path (str or os.PathLike)
   for (const auto& [k, v] : params) {
     const std::string name = k.cast<std::string>();
@@ -134,10 +142,13 @@ PyResult plan_one(const Session& s, const py::object& start, const py::object& g
   if (sim_threads < 1 || sim_threads > 1024) throw InputError("sim_threads: must be in [1, 1024]");
   const QueryDefaults defaults = query_defaults(sample_interval, raw);
   const nlohmann::json doc = query_doc(start, goal, planner, budget, seed, id, scene, params);
+  // A loaded scene: the problem is checked in its world, and planned there.
+  const WorldPtr loaded = py::isinstance<PyScene>(scene) ? scene.cast<PyScene>().world : nullptr;
   py::gil_scoped_release free;
   std::atomic<bool> cancel{false};
   SimulatorWorkspace ws(s.session->sim());
-  Query q = read(s, ws, doc, "", defaults);
+  Query q = read(s, ws, doc, "", defaults, loaded);
+  if (loaded) q.world = loaded;
   q.request.problem.termination.cancel = &cancel;
   return interruptible(cancel, [&] {
     RolloutPool pool(s.session->sim(), sim_threads);
@@ -384,6 +395,43 @@ py::object make_bundle_object(std::shared_ptr<const BundleView> view);
 
 namespace {
 
+PyScene load_scene(const Session& s, const py::object& env) {
+  if (py::isinstance<py::dict>(env)) {
+    const nlohmann::json doc = to_json(env, "env");
+    py::gil_scoped_release free;
+    try {
+      return PyScene{s.session->scenes.inline_scene(JsonField(doc, "", "env"))};
+    } catch (const Error& e) {
+      throw InputError(e.what());
+    }
+  }
+  const std::string path = py::str(env).cast<std::string>();
+  py::gil_scoped_release free;
+  return file_errors([&] { return PyScene{s.session->scenes.load(path)}; });
+}
+
+void bind_scene(py::module_& m) {
+  py::class_<PyScene>(m, "Scene",
+                      "A scene loaded once by PlanningSession.load_scene: its collision model "
+                      "is built, and plan(scene=...) plans in it without reading it again.")
+      .def_property_readonly(
+          "name", [](const PyScene& p) { return p.world->env.name; }, "The environment's name.")
+      .def_property_readonly(
+          "hash", [](const PyScene& p) { return p.world->env.identity; },
+          "Its content hash, as results carry it.")
+      .def_property_readonly(
+          "obstacles",
+          [](const PyScene& p) {
+            std::vector<std::string> names;
+            for (const Obstacle& o : p.world->env.obstacles) names.push_back(o.name);
+            return names;
+          },
+          "The obstacles' names.")
+      .def("__repr__", [](const PyScene& p) {
+        return "<lazyboe.Scene " + p.world->env.name + " " + p.world->env.identity + ">";
+      });
+}
+
 // What a PlanningSession holds, read-only.
 void bind_session_properties(py::class_<Session>& c) {
   c.def_property_readonly(
@@ -419,6 +467,7 @@ void bind_session_properties(py::class_<Session>& c) {
 
 void bind_planning(py::module_& m) {
   bind_result(m);
+  bind_scene(m);
   m.def("planners", &planners,
         "The planner registry: per planner its name, description, needs, availability in this "
         "build, and parameters (type, default, range, description).");
@@ -453,9 +502,10 @@ void bind_planning(py::module_& m) {
            "({'q': [...], 'tolerance': 0.1} or {'position': [x, y, z], 'tolerance': 0.02, "
            "'link': name}), planner (lazyboe.planners()), budget (s, default 5), seed (default "
            "1), and the planner's parameters by name as keywords (stop_at_first=True, "
-           "theta=0.4, ...). scene: the environment to plan in, an environment file's path or an "
-           "environment dict (default: the session's); scenes are kept by content, so naming "
-           "one again reuses its collision model. sample_interval: trajectory sample spacing, s (0.001: every control "
+           "theta=0.4, ...). scene: the environment to plan in: a Scene (load_scene), an "
+           "environment file's path or an environment dict (default: the session's); scenes "
+           "are kept by content, so naming one again reuses its collision model. "
+           "sample_interval: trajectory sample spacing, s (0.001: every control "
            "tick); sim_threads: threads simulating one query's edges (the answer does not depend "
            "on it); raw: the planner's edge chain with a stop at every junction (lazyboe-query "
            "--raw) instead of the executable trajectory (blended, shortcut). ValueError "
@@ -469,6 +519,11 @@ void bind_planning(py::module_& m) {
            "one); a query whose planner fails (RuntimeError from plan()) gets a result with its "
            "`error`, and the others are planned. Ctrl-C cancels the queries in flight and "
            "raises KeyboardInterrupt.");
+  session.def("load_scene", &load_scene, py::arg("env"),
+              "Loads a scene once (an environment file's path, or an environment dict) and "
+              "returns a Scene to pass as plan(scene=...): any scene of the bundle's robot. "
+              "Scenes are kept by content, so loading one again is cheap. OSError for a file "
+              "that cannot be read, ValueError for a bad environment.");
   bind_session_properties(session);
 }
 

@@ -62,3 +62,24 @@ def test_a_bad_scene_raises_value_error_naming_it(session, scene, message):
         plan(session, scene=scene)
     assert message in str(e.value)
     assert "\n" not in str(e.value)
+
+
+def test_a_loaded_scene_plans_as_its_file_does(session):
+    scene = session.load_scene(TABLE)
+    assert scene.name == "table" and "table_top" in scene.obstacles
+    loaded = plan(session, scene=scene)
+    by_path = plan(session, scene=TABLE)
+    assert loaded.scene == {"name": "table", "hash": scene.hash}
+    assert without_timings(loaded.to_dict()) == without_timings(by_path.to_dict())
+    # The start is checked in the loaded scene: a start inside one of its obstacles is refused.
+    inside = {"schema_version": 1, "name": "ball", "objects": [
+        {"name": "ball", "type": "sphere", "radius": 0.3, "position": [0.4, 0.0, 0.5]}]}
+    with pytest.raises(ValueError, match="start: in collision"):
+        plan(session, scene=session.load_scene(inside))
+
+
+def test_load_scene_errors(session, tmp_path):
+    with pytest.raises(OSError, match="nothing.json"):
+        session.load_scene(tmp_path / "nothing.json")
+    with pytest.raises(ValueError, match="env.objects"):
+        session.load_scene({"schema_version": 1, "name": "x"})
