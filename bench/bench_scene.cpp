@@ -29,12 +29,18 @@ json ten_objects() {
      "allowed_links": ["panda_link0", "panda_link1"]},
     {"name": "top", "type": "box", "size": [0.6, 1.2, 0.04], "position": [0.65, 0, 0.18]}]})");
   for (int k = 0; k < 4; ++k)
-    env["objects"].push_back({{"name", "leg" + std::to_string(k)}, {"type", "cylinder"},
-                              {"radius", 0.025}, {"length", 0.16},
-                              {"position", {0.375 + 0.55 * (k / 2), -0.575 + 1.15 * (k % 2), 0.08}}});
+    env["objects"].push_back(
+        {{"name", "leg" + std::to_string(k)},
+         {"type", "cylinder"},
+         {"radius", 0.025},
+         {"length", 0.16},
+         {"position", {0.375 + 0.55 * (k / 2), -0.575 + 1.15 * (k % 2), 0.08}}});
   for (int k = 0; k < 4; ++k)
-    env["objects"].push_back({{"name", "box" + std::to_string(k)}, {"type", k % 2 ? "box" : "cylinder"},
-                              {"size", {0.1, 0.15, 0.2}}, {"radius", 0.05}, {"length", 0.2},
+    env["objects"].push_back({{"name", "box" + std::to_string(k)},
+                              {"type", k % 2 ? "box" : "cylinder"},
+                              {"size", {0.1, 0.15, 0.2}},
+                              {"radius", 0.05},
+                              {"length", 0.2},
                               {"position", {0.5 + 0.1 * k, -0.4 + 0.25 * k, 0.3}}});
   for (json& o : env["objects"]) {  // only the fields of each type
     if (o["type"] == "box") o.erase("radius"), o.erase("length");
@@ -57,13 +63,15 @@ json cloud(int n) {
   }
   return {{"schema_version", 1},
           {"name", "cloud"},
-          {"objects", {{{"name", "cloud"}, {"type", "points"}, {"points", points}, {"resolution", 0.02}}}}};
+          {"objects",
+           {{{"name", "cloud"}, {"type", "points"}, {"points", points}, {"resolution", 0.02}}}}};
 }
 
 void prepare(benchmark::State& state, const json& env) {
   const SimulationOptions options;
   for (auto _ : state) {
-    const PlanningWorld world(panda(), environment_from_json(JsonField(env, "bench", ""), ""), options);
+    const PlanningWorld world(panda(), environment_from_json(JsonField(env, "bench", ""), ""),
+                              options);
     benchmark::DoNotOptimize(&world);
   }
 }

@@ -69,17 +69,16 @@ std::string BoxFiles::binary_stl() const {
 
 std::string BoxFiles::ply(bool binary) const {
   const std::vector<Eigen::Vector3d> pts = points();
-  std::string text = std::string("ply\nformat ") +
-                     (binary ? "binary_little_endian" : "ascii") + " 1.0\nelement vertex " +
-                     std::to_string(pts.size()) +
+  std::string text = std::string("ply\nformat ") + (binary ? "binary_little_endian" : "ascii") +
+                     " 1.0\nelement vertex " + std::to_string(pts.size()) +
                      "\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
   for (const Eigen::Vector3d& p : pts) {
     if (binary) {
       const Eigen::Vector3f f = p.cast<float>();
       text.append(reinterpret_cast<const char*>(f.data()), 12);
     } else {
-      text += std::to_string(p.x()) + " " + std::to_string(p.y()) + " " + std::to_string(p.z()) +
-              "\n";
+      text +=
+          std::to_string(p.x()) + " " + std::to_string(p.y()) + " " + std::to_string(p.z()) + "\n";
     }
   }
   return write_temp_file(name + (binary ? "-binary.ply" : ".ply"), text);

@@ -16,7 +16,7 @@ struct BoxFiles {
   double resolution = 0.01;      // of the voxelised points, m
   std::string name;              // file names start with it, under temp_dir()
 
-  TriangleMesh mesh() const;  // centred on the box's frame
+  TriangleMesh mesh() const;                    // centred on the box's frame
   std::vector<Eigen::Vector3d> points() const;  // base frame, every half resolution
   std::string obj() const;
   std::string binary_stl() const;

@@ -18,9 +18,9 @@
 #include <thread>
 
 #include "lazyboe/bundle/bundle_file.h"
-#include "lazyboe/common/atomic_file.h"
 #include "lazyboe/bundle/bundle_view.h"
 #include "lazyboe/bundle/hdf5_handle.h"
+#include "lazyboe/common/atomic_file.h"
 #include "lazyboe/common/error.h"
 #include "lazyboe/common/hash.h"
 #include "test_util.h"

@@ -12,12 +12,12 @@
 #include <string>
 #include <vector>
 
+#include "box_files.h"
 #include "lazyboe/collision/collision_model.h"
 #include "lazyboe/collision/environment.h"
 #include "lazyboe/collision/mesh.h"
 #include "lazyboe/common/error.h"
 #include "lazyboe/robot/kinematics.h"
-#include "box_files.h"
 #include "test_util.h"
 
 namespace lazyboe {
@@ -53,18 +53,24 @@ Environment scene_with(json object) {
 
 std::vector<Environment> representations() {
   std::vector<Environment> envs;
-  envs.push_back(scene_with(
-      {{"name", "box"}, {"type", "box"}, {"size", position(kSize)}, {"position", position(kCentre)}}));
+  envs.push_back(scene_with({{"name", "box"},
+                             {"type", "box"},
+                             {"size", position(kSize)},
+                             {"position", position(kCentre)}}));
   for (const std::string& mesh : {kBox.obj(), kBox.binary_stl()})
     envs.push_back(scene_with(
         {{"name", "box"}, {"type", "mesh"}, {"file", mesh}, {"position", position(kCentre)}}));
   for (const bool binary : {false, true})
-    envs.push_back(scene_with(
-        {{"name", "box"}, {"type", "points"}, {"file", kBox.ply(binary)}, {"resolution", kResolution}}));
+    envs.push_back(scene_with({{"name", "box"},
+                               {"type", "points"},
+                               {"file", kBox.ply(binary)},
+                               {"resolution", kResolution}}));
   json inline_points = json::array();
   for (const Eigen::Vector3d& p : kBox.points()) inline_points.push_back(position(p));
-  envs.push_back(scene_with(
-      {{"name", "box"}, {"type", "points"}, {"points", inline_points}, {"resolution", kResolution}}));
+  envs.push_back(scene_with({{"name", "box"},
+                             {"type", "points"},
+                             {"points", inline_points},
+                             {"resolution", kResolution}}));
   envs.push_back(scene_with({{"name", "box"}, {"type", "octree"}, {"file", kBox.bt()}}));
   return envs;
 }
@@ -122,7 +128,9 @@ TEST(ObstacleFiles, DistancesAgreeAwayFromTheBox) {
     update_collision_transforms(box, a, rd);
     update_collision_transforms(mesh, b, rd);
     const double d = min_distance(box, a).env_distance, e = min_distance(mesh, b).env_distance;
-    if (d > 0.01) EXPECT_NEAR(e, d, 1e-3) << k;
+    if (d > 0.01) {
+      EXPECT_NEAR(e, d, 1e-3) << k;
+    }
   }
 }
 
@@ -185,7 +193,8 @@ TEST(ObstacleFiles, BadFilesAndFieldsAreOneErrorNamingThem) {
        {"objects[1]", "no point"}},
       {{{"name", "p"}, {"type", "points"}, {"points", {{0, 0, 0}}}, {"resolution", 0}},
        {"objects[1].resolution"}},
-      {{{"name", "p"}, {"type", "points"}, {"resolution", 0.02}}, {"objects[1]", "\"file\" or \"points\""}},
+      {{{"name", "p"}, {"type", "points"}, {"resolution", 0.02}},
+       {"objects[1]", "\"file\" or \"points\""}},
       {{{"name", "m"}, {"type", "mesh"}, {"file", ""}}, {"objects[1].file", "must not be empty"}},
       {{{"name", "m"}, {"type", "mesh"}, {"file", text}, {"radius", 1}},
        {"objects[1].radius", "unknown field"}},

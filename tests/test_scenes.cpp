@@ -51,16 +51,17 @@ struct Fixture {
 
 const Fixture& fixture() { return shared_fixture<Fixture>(); }
 
-json table_scene() {
-  return json::parse(read_file(source_path("data/environments/table.json")));
-}
+json table_scene() { return json::parse(read_file(source_path("data/environments/table.json"))); }
 
 // BoE from start to goal, deterministic: it stops at its first solution.
 json query(const std::string& id) {
   const Fixture& f = fixture();
-  return {{"id", id},         {"start", vec(f.start)},
-          {"planner", "boe"}, {"goal", {{"q", vec(f.goal)}, {"tolerance", 0.3}}},
-          {"seed", 3},        {"stop_at_first", true},
+  return {{"id", id},
+          {"start", vec(f.start)},
+          {"planner", "boe"},
+          {"goal", {{"q", vec(f.goal)}, {"tolerance", 0.3}}},
+          {"seed", 3},
+          {"stop_at_first", true},
           {"budget", 30 * time_scale()}};
 }
 
@@ -226,7 +227,8 @@ TEST(Scenes, SwitchingScenesInOneProcessAnswersAsSeparateProcessesDo) {
     SCOPED_TRACE(k);
     ASSERT_TRUE(together[k].value("success", false)) << together[k].dump().substr(0, 600);
     EXPECT_TRUE(timeless(together[k]) == timeless(alone[0]))
-        << together[k].dump().substr(0, 400) << "\n" << alone[0].dump().substr(0, 400);
+        << together[k].dump().substr(0, 400) << "\n"
+        << alone[0].dump().substr(0, 400);
   }
   EXPECT_NE(together[0]["scene"]["hash"], together[1]["scene"]["hash"]);
   EXPECT_NE(together[0]["edges"], together[1]["edges"]) << "the ball changed nothing";
@@ -243,10 +245,11 @@ TEST(Scenes, TheSameBoxAsAPrimitiveMeshCloudAndOctreeIsGoneAround) {
   const json at = blocked_scene(open, grown)["objects"].back()["position"];
   const BoxFiles box{Eigen::Vector3d(at[0], at[1], at[2]), Eigen::Vector3d::Constant(0.06), 0.01,
                      "scenes/box"};
-  const std::vector<json> objects = {{{"type", "box"}, {"size", {0.06, 0.06, 0.06}}},
-                               {{"type", "mesh"}, {"file", box.obj()}},
-                               {{"type", "points"}, {"file", box.ply(true)}, {"resolution", 0.01}},
-                               {{"type", "octree"}, {"file", box.bt()}}};
+  const std::vector<json> objects = {
+      {{"type", "box"}, {"size", {0.06, 0.06, 0.06}}},
+      {{"type", "mesh"}, {"file", box.obj()}},
+      {{"type", "points"}, {"file", box.ply(true)}, {"resolution", 0.01}},
+      {{"type", "octree"}, {"file", box.bt()}}};
   std::string primitive_file;
   for (size_t k = 0; k < objects.size(); ++k) {
     json object = objects[k];
@@ -255,8 +258,8 @@ TEST(Scenes, TheSameBoxAsAPrimitiveMeshCloudAndOctreeIsGoneAround) {
     json scene = table_scene();
     scene["name"] = "box-" + object["type"].get<std::string>();
     scene["objects"].push_back(object);
-    const std::string file = write_temp_file("scenes/" + scene["name"].get<std::string>() + ".json",
-                                             scene.dump());
+    const std::string file =
+        write_temp_file("scenes/" + scene["name"].get<std::string>() + ".json", scene.dump());
     if (k == 0) primitive_file = file;
     json q = query("around");
     q["scene"] = file;
@@ -309,8 +312,8 @@ TEST(Scenes, AnEnvironmentForAnotherRobotIsRefusedWithOneLine) {
   const std::string file = write_temp_file("scenes/ur5-floor.json", scene.dump());
   const std::string queries = write_temp_file("scenes/one.jsonl", query("one").dump() + "\n");
   const CommandResult r =
-      run(quote(tool_path("lazyboe-query")) + " --bundle " + quote(fixture().path) +
-          " --queries " + quote(queries) + " --env " + quote(file));
+      run(quote(tool_path("lazyboe-query")) + " --bundle " + quote(fixture().path) + " --queries " +
+          quote(queries) + " --env " + quote(file));
   EXPECT_EQ(r.exit_code, 1) << describe(r);
   expect_one_line_error(r, {file, "base_link", "is not a link of robot"});
 }

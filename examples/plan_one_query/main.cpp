@@ -2,8 +2,8 @@
 //   plan_one_query BUNDLE START GOAL [PLANNER [TOLERANCE [BUDGET]]]
 // START and GOAL are comma-separated joint values; PLANNER a registered planner (default
 // lazyboe); TOLERANCE the joint-space goal radius in rad (default 0.3); BUDGET the planning
-// time limit in s (default 5). Prints the result and the executable trajectory's duration, stops and
-// cost; exit status 0 on success.
+// time limit in s (default 5). Prints the result and the executable trajectory's duration, stops
+// and cost; exit status 0 on success.
 #include <cstdio>
 #include <cstdlib>
 #include <sstream>

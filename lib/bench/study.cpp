@@ -147,7 +147,7 @@ RunRecord run_planner(const PlanningContext& context, SimulatorWorkspace& ws,
   PlanAnswer a;
   try {
     a = answer_request(context, request, ws);
-  } catch (const std::exception& e) {  // nothing may leave a run (an OpenMP region)
+  } catch (const std::exception& e) {               // nothing may leave a run (an OpenMP region)
     r.failure = std::string("error: ") + e.what();  // a path that failed its re-check, too
     return r;
   }
@@ -180,10 +180,10 @@ std::vector<RunRecord> run_study(const PlanningContext& context,
     stop = !error.empty();
     if (stop || (control.stop_requested && control.stop_requested())) continue;
     const StudyTask& task = tasks[k];
-    RunRecord r = run_planner(context, workspaces[omp_get_thread_num()], planners[task.planner],
-                              problems[task.problem], task.problem, task.repeat,
-                              run_seed(study_seed, task.problem, task.repeat), budget,
-                              control.output);
+    RunRecord r =
+        run_planner(context, workspaces[omp_get_thread_num()], planners[task.planner],
+                    problems[task.problem], task.problem, task.repeat,
+                    run_seed(study_seed, task.problem, task.repeat), budget, control.output);
 #pragma omp critical(lazyboe_study_finished)
     {
       ++finished;

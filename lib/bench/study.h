@@ -9,8 +9,8 @@
 
 #include "lazyboe/bench/problems.h"
 #include "lazyboe/planning/execution.h"
-#include "lazyboe/planning/request.h"
 #include "lazyboe/planning/parameters.h"
+#include "lazyboe/planning/request.h"
 
 namespace lazyboe {
 

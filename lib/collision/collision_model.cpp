@@ -146,9 +146,11 @@ inline bool is_primitive(const fcl::CollisionGeometryd* g) {
 
 // A mesh or an octree against a robot shape, through fcl::collide (one contact is enough). Kept
 // out of line: inlined, its setup would weigh on every culled pair of the primitives' path.
-[[gnu::noinline]] bool collide_with_bvh(const CollisionData& data, const fcl::CollisionGeometryd* shape,
-                      const fcl::Transform3d& t1, const fcl::CollisionGeometryd* obstacle,
-                      const fcl::Transform3d& t2) {
+[[gnu::noinline]] bool collide_with_bvh(const CollisionData& data,
+                                        const fcl::CollisionGeometryd* shape,
+                                        const fcl::Transform3d& t1,
+                                        const fcl::CollisionGeometryd* obstacle,
+                                        const fcl::Transform3d& t2) {
   CollisionScratch& s = *data.scratch;
   s.collision_result.clear();
   return fcl::collide(shape, t1, obstacle, t2, s.collision_request, s.collision_result) > 0;
@@ -157,7 +159,8 @@ inline bool is_primitive(const fcl::CollisionGeometryd* g) {
 double narrow_distance(CollisionData& data, const fcl::CollisionGeometryd* g1,
                        const fcl::Transform3d& t1, const fcl::CollisionGeometryd* g2,
                        const fcl::Transform3d& t2) {
-  if (is_primitive(g2) ? narrow_collide(g1, t1, g2, t2) : collide_with_bvh(data, g1, t1, g2, t2)) return 0;
+  if (is_primitive(g2) ? narrow_collide(g1, t1, g2, t2) : collide_with_bvh(data, g1, t1, g2, t2))
+    return 0;
   data.scratch->distance_result.clear();
   const double d =
       fcl::distance(g1, t1, g2, t2, data.scratch->distance_request, data.scratch->distance_result);
@@ -256,8 +259,9 @@ CollisionModel build_collision_model(const RobotModel& robot, const Environment&
     for (const std::string& name : env.obstacles[o].allowed_links) {
       const int link = robot.link_index(name);
       if (link < 0) {
-        fail(env.origin.empty() ? env.path : env.origin, "object '" + env.obstacles[o].name + "': allowed link '" + name +
-                           "' is not a link of robot '" + robot.name + "'");
+        fail(env.origin.empty() ? env.path : env.origin,
+             "object '" + env.obstacles[o].name + "': allowed link '" + name +
+                 "' is not a link of robot '" + robot.name + "'");
       }
       allowed.push_back(link);
     }

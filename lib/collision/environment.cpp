@@ -85,10 +85,9 @@ std::vector<Eigen::Vector3d> inline_points(const JsonField& f) {
 }
 
 // Meshes, point clouds and octrees; their files are recorded in env.files.
-void parse_geometry(const JsonField& item, const std::string& type, Environment& env,
-                    Obstacle& o) {
-  const std::vector<std::string> placed = {"name", "type", "position", "rpy", "quaternion",
-                                           "allowed_links"};
+void parse_geometry(const JsonField& item, const std::string& type, Environment& env, Obstacle& o) {
+  const std::vector<std::string> placed = {"name", "type",       "position",
+                                           "rpy",  "quaternion", "allowed_links"};
   auto allow = [&](std::vector<std::string> extra) {
     extra.insert(extra.end(), placed.begin(), placed.end());
     item.allow_only(extra);
@@ -102,7 +101,8 @@ void parse_geometry(const JsonField& item, const std::string& type, Environment&
     env.files.push_back(file);
   } else if (type == "points") {
     allow({"file", "points", "resolution"});
-    if (item.has("file") == item.has("points")) item.fail("give \"file\" or \"points\", one of them");
+    if (item.has("file") == item.has("points"))
+      item.fail("give \"file\" or \"points\", one of them");
     const double resolution = item.at("resolution").number_in({0, 100, true}, " m");
     std::vector<Eigen::Vector3d> points;
     if (item.has("file")) {

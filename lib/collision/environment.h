@@ -18,11 +18,11 @@ enum class ObstacleType { Primitive, Mesh, Octree };
 struct Obstacle {
   std::string name;
   ObstacleType type = ObstacleType::Primitive;
-  Shape shape;                                  // Primitive
-  std::shared_ptr<const TriangleMesh> mesh;     // Mesh: in the obstacle's frame, scaled
+  Shape shape;                                   // Primitive
+  std::shared_ptr<const TriangleMesh> mesh;      // Mesh: in the obstacle's frame, scaled
   std::shared_ptr<const octomap::OcTree> cells;  // Octree: occupied cells, obstacle's frame
-  Pose pose;                               // in the robot's base frame
-  std::vector<std::string> allowed_links;  // robot links allowed to touch this obstacle
+  Pose pose;                                     // in the robot's base frame
+  std::vector<std::string> allowed_links;        // robot links allowed to touch this obstacle
 };
 
 struct Environment {

@@ -54,9 +54,9 @@ void add_node(const aiScene& scene, const aiNode& node, const aiMatrix4x4& paren
 
 TriangleMesh load_mesh(const std::string& path, const Eigen::Vector3d& scale) {
   Assimp::Importer importer;
-  const aiScene* scene = read_scene(importer, path,
-                                    aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
-                                        aiProcess_SortByPType);
+  const aiScene* scene =
+      read_scene(importer, path,
+                 aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_SortByPType);
   TriangleMesh mesh;
   add_node(*scene, *scene->mRootNode, aiMatrix4x4(), scale, mesh);
   if (mesh.triangles.empty()) fail(path, "has no triangle (not a mesh)");

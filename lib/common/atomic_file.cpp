@@ -1,11 +1,10 @@
 #include "lazyboe/common/atomic_file.h"
 
-#include <atomic>
-
 #include <fcntl.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>

@@ -131,9 +131,7 @@ nlohmann::json load_json_file(const std::string& path) {
 JsonField::JsonField(const nlohmann::json& value, std::string file, std::string path)
     : value_(&value), file_(std::move(file)), path_(std::move(path)) {}
 
-void JsonField::fail(const std::string& what) const {
-  lazyboe::fail(where(), what);
-}
+void JsonField::fail(const std::string& what) const { lazyboe::fail(where(), what); }
 
 bool JsonField::has(const std::string& key) const {
   return value_->is_object() && value_->contains(key);
@@ -143,7 +141,8 @@ JsonField JsonField::at(const std::string& key) const {
   if (!value_->is_object()) fail("expected an object");
   auto it = value_->find(key);
   const std::string child = path_.empty() ? key : path_ + "." + key;
-  if (it == value_->end()) lazyboe::fail(JsonField(*value_, file_, child).where(), "missing required field");
+  if (it == value_->end())
+    lazyboe::fail(JsonField(*value_, file_, child).where(), "missing required field");
   return JsonField(*it, file_, child);
 }
 

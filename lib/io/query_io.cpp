@@ -56,8 +56,8 @@ void parse_planner(const JsonField& root, PlanRequest& r) {
     const JsonField f = root.at(name);
     const ParameterSpec* spec = info.parameter(name);
     if (!spec) {
-      f.fail("not a parameter of " + r.planner + " (its parameters: " +
-             parameter_names_text(info) + ")");
+      f.fail("not a parameter of " + r.planner + " (its parameters: " + parameter_names_text(info) +
+             ")");
     }
     const double v = parameter_value(f, *spec);
     const std::string why = spec->check(v);
@@ -96,9 +96,17 @@ void parse_goal(const JsonField& goal, const RobotModel& robot, const QueryDefau
 // The fields a query may have: its own, and every parameter a registered planner declares.
 const std::vector<std::string>& query_fields() {
   static const std::vector<std::string> fields = [] {
-    std::vector<std::string> f = {"id",    "start", "goal",          "planner",
-                                  "budget", "seed", "stop_at_first", "scene",
-                                  "raw",   "sample_interval", "shortcut_attempts"};
+    std::vector<std::string> f = {"id",
+                                  "start",
+                                  "goal",
+                                  "planner",
+                                  "budget",
+                                  "seed",
+                                  "stop_at_first",
+                                  "scene",
+                                  "raw",
+                                  "sample_interval",
+                                  "shortcut_attempts"};
     for (const std::string& name : all_parameter_names()) f.push_back(name);
     return f;
   }();

@@ -37,8 +37,7 @@ struct QueryDefaults {
 // planner declares. Throws Error("line N: field: what") for anything malformed, out of range,
 // out of limits or in collision.
 Query parse_query(const std::string& text, int line, const Simulator& sim, SimulatorWorkspace& ws,
-                  const QueryDefaults& defaults, std::string& id_out,
-                  SceneCache* scenes = nullptr);
+                  const QueryDefaults& defaults, std::string& id_out, SceneCache* scenes = nullptr);
 // The same for a query held as JSON; `where` starts its errors ("line 3", "queries[2]"; empty:
 // the field alone).
 Query read_query(const nlohmann::json& doc, const std::string& where, const Simulator& sim,

@@ -54,15 +54,15 @@ class PlanningSession {
  public:
   // What is mapped and shared, whatever the world (the model side):
   const BundleView bundle;
-  const RobotModel robot;          // the bundle's, checked by content hash
-  const BuildSettings settings;    // the bundle's simulation, command and region settings
+  const RobotModel robot;        // the bundle's, checked by content hash
+  const BuildSettings settings;  // the bundle's simulation, command and region settings
   // The worlds planned in (world.h): the default, and scenes queries name (by content).
   mutable SceneCache scenes;
   const BundleIndexes indexes;     // where they come from: indexes.source
   const EdgeIndex& index;          // edge start states: the planners' neighbourhoods
   const EdgeIndex& end_index;      // edge end states: goal coverage
   const double mean_displacement;  // mean_edge_displacement(bundle), for context()
-  const double load_seconds;  // wall time of everything above
+  const double load_seconds;       // wall time of everything above
 
   const PlanningWorld& world() const { return *scenes.default_world(); }
   const Simulator& sim() const { return world().sim; }  // the default world's

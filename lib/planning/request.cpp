@@ -26,10 +26,10 @@ PlanAnswer answer_request(const PlanningContext& context, const PlanRequest& req
     if (request.problem.termination.cancelled()) a.result.failure = "cancelled";
     return a;
   }
-  a.trajectory = returned_trajectory(
-      context.sim, ws, request.problem, a.result.best_path, a.raw,
-      execution_options(context, request.output), returned_sample_every(context.sim, request.output),
-      a.execution);
+  a.trajectory =
+      returned_trajectory(context.sim, ws, request.problem, a.result.best_path, a.raw,
+                          execution_options(context, request.output),
+                          returned_sample_every(context.sim, request.output), a.execution);
   return a;
 }
 

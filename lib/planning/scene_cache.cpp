@@ -15,20 +15,26 @@ WorldPtr SceneCache::inline_scene(const JsonField& scene) {
   return world(environment_from_json(scene, ""));
 }
 
+WorldPtr SceneCache::find(const std::string& identity) {
+  for (auto it = recent_.begin(); it != recent_.end(); ++it) {
+    if ((*it)->env.identity != identity) continue;
+    recent_.splice(recent_.begin(), recent_, it);
+    return recent_.front();
+  }
+  return nullptr;
+}
+
 WorldPtr SceneCache::world(Environment env) {
   if (env.identity == default_world_->env.identity) return default_world_;
   {
     const std::lock_guard<std::mutex> lock(mutex_);
-    for (auto it = recent_.begin(); it != recent_.end(); ++it) {
-      if ((*it)->env.identity != env.identity) continue;
-      recent_.splice(recent_.begin(), recent_, it);
-      return recent_.front();
-    }
+    if (WorldPtr known = find(env.identity)) return known;
   }
-  // Built outside the lock (FCL's geometry takes milliseconds); two threads asking for one new
-  // scene at once may each build it: both are the same world.
+  // Built outside the lock (FCL's geometry can take milliseconds); of two threads that built
+  // one new scene at once, the first to come back is kept and given to both.
   auto made = std::make_shared<const PlanningWorld>(robot_, std::move(env), options_);
   const std::lock_guard<std::mutex> lock(mutex_);
+  if (WorldPtr known = find(made->env.identity)) return known;
   recent_.push_front(made);
   if (recent_.size() > capacity_) recent_.pop_back();
   return made;

@@ -28,6 +28,8 @@ class SceneCache {
   WorldPtr world(Environment env);
 
  private:
+  WorldPtr find(const std::string& identity);  // moved to the front; null if not kept (locked)
+
   const RobotModel& robot_;
   const SimulationOptions options_;
   const WorldPtr default_world_;

@@ -78,8 +78,11 @@ json mesh_json(const Obstacle& o) {
     for (int c = 0; c < 3; ++c) vertices.push_back(v[c]);
   for (const Eigen::Vector3i& t : o.mesh->triangles)
     for (int c = 0; c < 3; ++c) triangles.push_back(t[c]);
-  return {{"name", o.name},         {"type", "mesh"},   {"vertices", vertices},
-          {"triangles", triangles}, {"pose", pose_json(o.pose)}};
+  return {{"name", o.name},
+          {"type", "mesh"},
+          {"vertices", vertices},
+          {"triangles", triangles},
+          {"pose", pose_json(o.pose)}};
 }
 
 // An octree obstacle (a voxelised cloud, an OctoMap): its occupied cells, centres and sizes.

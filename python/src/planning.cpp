@@ -6,8 +6,8 @@
 
 #include <atomic>
 #include <chrono>
-#include <future>
 #include <exception>
+#include <future>
 #include <memory>
 
 #include "convert.h"
@@ -306,8 +306,7 @@ void bind_result_extras(py::class_<PyResult>& c) {
        "plan_many: why this query could not be planned (the planner failed: the others "
        "were planned); None otherwise.")
       .def_property_readonly(
-          "scene",
-          [](const PyResult& r) { return scene_dict(r.world->env); },
+          "scene", [](const PyResult& r) { return scene_dict(r.world->env); },
           "The scene it was planned in: {'name', 'hash'}.");
 }
 
@@ -354,8 +353,9 @@ void bind_result(py::module_& m) {
       .def_property_readonly(
           "found_by",
           [](const PyResult& r) -> py::object {
-            return r.result().found_by.empty() || !r.result().success ? py::object(py::none())
-                                                                  : py::str(r.result().found_by);
+            return r.result().found_by.empty() || !r.result().success
+                       ? py::object(py::none())
+                       : py::str(r.result().found_by);
           },
           "Which part of the planner found the best path (lazysp: bundle or growth), or None.")
       .def_property_readonly(
@@ -373,8 +373,8 @@ void bind_result(py::module_& m) {
           "trajectory",
           [](const PyResult& r) -> py::object {
             if (!r.result().success) return py::none();
-            return py::cast(
-                trajectory_of(r.trajectory(), static_cast<int>(r.query.request.problem.start.size())));
+            return py::cast(trajectory_of(r.trajectory(),
+                                          static_cast<int>(r.query.request.problem.start.size())));
           },
           "The trajectory (t, q, dq, ddq, cmd, edges, cost, duration, stops): the executable one, "
           "or the raw chain with raw=True; None without a solution.")
@@ -384,7 +384,7 @@ void bind_result(py::module_& m) {
       .def("__repr__", [](const PyResult& r) {
         return "<lazyboe.PlanResult " + r.query.request.planner +
                (r.result().success ? ": solved, cost " + std::to_string(r.trajectory().cost)
-                                 : ": " + r.result().failure) +
+                                   : ": " + r.result().failure) +
                ">";
       });
 }
@@ -435,11 +435,11 @@ void bind_scene(py::module_& m) {
 // What a PlanningSession holds, read-only.
 void bind_session_properties(py::class_<Session>& c) {
   c.def_property_readonly(
-          "robot",
-          [](const Session& s) {
-            return PyRobot{std::shared_ptr<const RobotModel>(s.session, &s.session->robot)};
-          },
-          "The bundle's robot (a lazyboe.Robot).")
+       "robot",
+       [](const Session& s) {
+         return PyRobot{std::shared_ptr<const RobotModel>(s.session, &s.session->robot)};
+       },
+       "The bundle's robot (a lazyboe.Robot).")
       .def_property_readonly(
           "bundle",
           [](const Session& s) {
@@ -448,8 +448,7 @@ void bind_session_properties(py::class_<Session>& c) {
           },
           "The bundle (a lazyboe.Bundle sharing the session's mapping).")
       .def_property_readonly(
-          "scene",
-          [](const Session& s) { return scene_dict(s.session->world().env); },
+          "scene", [](const Session& s) { return scene_dict(s.session->world().env); },
           "The default scene planned in: {'name', 'hash'} (the content hash results carry).")
       .def_property_readonly(
           "load_seconds", [](const Session& s) { return s.session->load_seconds; },
@@ -497,7 +496,8 @@ void bind_planning(py::module_& m) {
            "a missing or corrupt bundle or a mismatching robot.")
       .def("plan", &plan_one, py::arg("start"), py::arg("goal"), py::arg("planner") = "lazyboe",
            py::arg("budget") = py::none(), py::arg("seed") = py::none(), py::arg("id") = "",
-           py::arg("scene") = py::none(), py::arg("sample_interval") = 0.01, py::arg("sim_threads") = 1, py::arg("raw") = false,
+           py::arg("scene") = py::none(), py::arg("sample_interval") = 0.01,
+           py::arg("sim_threads") = 1, py::arg("raw") = false,
            "Plans one query, as a line of lazyboe-query would: start (dof values), goal "
            "({'q': [...], 'tolerance': 0.1} or {'position': [x, y, z], 'tolerance': 0.02, "
            "'link': name}), planner (lazyboe.planners()), budget (s, default 5), seed (default "
