@@ -22,7 +22,8 @@ start=0,0.25,0,-2,0,1.9,0.8
 goal=0.2,0.1,0.15,-1.85,-0.15,2.0,0.9
 # The planning budget scales with LAZYBOE_TEST_TIME_SCALE (sanitizer builds are ~10x slower).
 budget=$(awk -v s="${LAZYBOE_TEST_TIME_SCALE:-1}" 'BEGIN { print 5 * s }')
-for planner in lazyboe boe rrt; do
+# "straight" is the example's own planner, registered at run time (register_planner).
+for planner in lazyboe boe rrt straight; do
   out=$("$work/example/plan_one_query" "$work/b.h5" "$start" "$goal" "$planner" 0.3 "$budget")
   echo "$out"
   case "$out" in "$planner: solved in "*) ;; *) echo "FAIL: $planner did not solve"; exit 1 ;; esac

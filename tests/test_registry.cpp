@@ -105,6 +105,40 @@ TEST(Registry, NamesAndLookups) {
   EXPECT_EQ(all.size(), 10u);  // each once
 }
 
+// The refusals only: a planner registered here would stay for the other tests of a process that
+// runs them all (the install test registers one and plans with it, examples/plan_one_query).
+TEST(Registry, RegisterPlannerRefusesWhatWouldClash) {
+  auto make = [](const ParameterValues&) -> std::unique_ptr<Planner> { return nullptr; };
+  auto info = [&](const std::string& name, std::vector<ParameterSpec> parameters = {}) {
+    PlannerInfo i;
+    i.name = name;
+    i.description = "a test planner";
+    i.parameters = std::move(parameters);
+    i.make = make;
+    return i;
+  };
+  const size_t before = planner_registry().size();
+  EXPECT_EQ(message_of([&] { register_planner(info("")); }),
+            "register_planner: a planner needs a name");
+  EXPECT_EQ(message_of([&] { register_planner(info("rrt")); }),
+            "register_planner: a planner 'rrt' is registered already");
+  PlannerInfo no_factory = info("mine");
+  no_factory.make = nullptr;
+  EXPECT_EQ(message_of([&] { register_planner(no_factory); }),
+            "register_planner: planner 'mine' has no factory (make)");
+  ParameterSpec budget = real_parameter("budget", 1, 0, true, "clashes with the query field");
+  EXPECT_EQ(message_of([&] { register_planner(info("mine", {budget})); }),
+            "register_planner: planner 'mine': 'budget' is a query field");
+  ParameterSpec theta = real_parameter("theta", 1, 0, true, "a real theta");
+  theta.type = ParameterType::Integer;
+  EXPECT_NE(message_of([&] {
+              register_planner(info("mine", {theta}));
+            }).find("parameter 'theta' has another type"),
+            std::string::npos);
+  EXPECT_EQ(planner_registry().size(), before);
+  EXPECT_EQ(find_planner("mine"), nullptr);
+}
+
 TEST(Registry, MakePlannerChecksValues) {
   EXPECT_EQ(message_of([] { make_planner("rrt", {{"theta", 0.3}}); }), "rrt: no parameter 'theta'");
   EXPECT_EQ(message_of([] { make_planner("boe", {{"theta", -1}}); }), "theta: must be > 0");

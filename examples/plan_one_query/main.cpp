@@ -1,7 +1,8 @@
 // Plans one query on an edge bundle with the installed library:
 //   plan_one_query BUNDLE START GOAL [PLANNER [TOLERANCE [BUDGET]]]
 // START and GOAL are comma-separated joint values; PLANNER a registered planner (default
-// lazyboe); TOLERANCE the joint-space goal radius in rad (default 0.3); BUDGET the planning
+// lazyboe), or "straight", the example planner this program registers (straight_planner.h);
+// TOLERANCE the joint-space goal radius in rad (default 0.3); BUDGET the planning
 // time limit in s (default 5). Prints the result and the executable trajectory's duration, stops
 // and cost; exit status 0 on success.
 #include <cstdio>
@@ -15,6 +16,7 @@
 #include "lazyboe/planning/planning_session.h"
 #include "lazyboe/planning/problem.h"
 #include "lazyboe/planning/request.h"
+#include "straight_planner.h"
 
 namespace {
 
@@ -34,6 +36,7 @@ int main(int argc, char** argv) {
     return 2;
   }
   try {
+    straight::register_straight_planner();  // a planner of our own, beside the library's
     // The bundle (memory-mapped), its robot and neighbour indexes, and its own scene's
     // simulator (session.sim()).
     const lazyboe::PlanningSession session(argv[1], true, "", "");

@@ -1,6 +1,7 @@
 #include "lazyboe/planning/registry.h"
 
 #include <algorithm>
+#include <deque>
 #include <sstream>
 
 #include "lazyboe/common/error.h"
@@ -14,14 +15,47 @@
 
 namespace lazyboe {
 
-const std::vector<PlannerInfo>& planner_registry() {
-  static const std::vector<PlannerInfo> registry = {
+namespace {
+
+// A deque: registering a planner keeps every reference to the others valid.
+std::deque<PlannerInfo>& registry() {
+  static std::deque<PlannerInfo> planners = {
       lazyboe_planner_info(),  // the paper's planner first: the default
       boe_planner_info(),         rrt_planner_info(),      sst_planner_info(),
       lazysp_planner_info(),      ompl_rrt_planner_info(), ompl_sst_planner_info(),
       ompl_kpiece_planner_info(),
   };
-  return registry;
+  return planners;
+}
+
+void check_new_planner(const PlannerInfo& info) {
+  const std::string where = "register_planner";
+  if (info.name.empty()) fail(where, "a planner needs a name");
+  if (find_planner(info.name)) fail(where, "a planner '" + info.name + "' is registered already");
+  if (!info.make) fail(where, "planner '" + info.name + "' has no factory (make)");
+  for (const ParameterSpec& p : info.parameters) {
+    if (p.name.empty()) fail(where, "planner '" + info.name + "': a parameter needs a name");
+    const std::string known[] = {
+        "id",   "start", "goal", "planner",         "stop_at_first",    "budget",
+        "seed", "scene", "raw",  "sample_interval", "shortcut_attempts"};
+    if (std::find(std::begin(known), std::end(known), p.name) != std::end(known))
+      fail(where, "planner '" + info.name + "': '" + p.name + "' is a query field");
+    for (const PlannerInfo& other : registry()) {
+      const ParameterSpec* same = other.parameter(p.name);
+      if (same && same->type != p.type)
+        fail(where, "planner '" + info.name + "': parameter '" + p.name + "' has another type " +
+                        "in " + other.name);
+    }
+  }
+}
+
+}  // namespace
+
+const std::deque<PlannerInfo>& planner_registry() { return registry(); }
+
+void register_planner(PlannerInfo info) {
+  check_new_planner(info);
+  registry().push_back(std::move(info));
 }
 
 const ParameterSpec* PlannerInfo::parameter(const std::string& key) const {
@@ -61,17 +95,14 @@ std::vector<std::string> planner_names() {
 
 std::string planner_names_text() { return list_text(planner_names()); }
 
-const std::vector<std::string>& all_parameter_names() {
-  static const std::vector<std::string> names = [] {
-    std::vector<std::string> out;
-    for (const PlannerInfo& info : planner_registry()) {
-      for (const ParameterSpec& p : info.parameters) {
-        if (std::find(out.begin(), out.end(), p.name) == out.end()) out.push_back(p.name);
-      }
+std::vector<std::string> all_parameter_names() {
+  std::vector<std::string> out;
+  for (const PlannerInfo& info : planner_registry()) {
+    for (const ParameterSpec& p : info.parameters) {
+      if (std::find(out.begin(), out.end(), p.name) == out.end()) out.push_back(p.name);
     }
-    return out;
-  }();
-  return names;
+  }
+  return out;
 }
 
 std::unique_ptr<Planner> make_planner(const std::string& name, const ParameterValues& values) {

@@ -1,9 +1,11 @@
 // The planner registry: each planner once, with its name, description, needs, parameters and
 // factory. Query parsing, the query schema's planner list (checked by a test), lazyboe-bench's
 // planners and `lazyboe-query --list-planners` all come from it. Adding a planner: one file
-// pair under planners/ that defines its PlannerInfo, and one line in registry.cpp.
+// pair under planners/ that defines its PlannerInfo, and one line in registry.cpp; or, from
+// outside the library, register_planner().
 #pragma once
 
+#include <deque>
 #include <functional>
 #include <memory>
 #include <string>
@@ -42,8 +44,15 @@ struct PlannerInfo {
   bool available(std::string* why = nullptr) const;
 };
 
-// Every planner, in the order they are listed.
-const std::vector<PlannerInfo>& planner_registry();
+// Every planner, in the order they are listed: the built-in ones, then those registered.
+const std::deque<PlannerInfo>& planner_registry();
+
+// Adds a planner defined outside the library (OMPL's "subclass base::Planner"): from then on
+// queries can name it, lazyboe-bench can run it, and --list-planners and Python's planners()
+// show it. Call it before planning starts (not while another thread plans or reads the
+// registry). Throws Error for an empty or taken name, no factory, a parameter named like a
+// query field, or a parameter another planner declares with another type.
+void register_planner(PlannerInfo info);
 
 // The planner of that name, or null.
 const PlannerInfo* find_planner(const std::string& name);
@@ -56,7 +65,7 @@ std::vector<std::string> planner_names();
 std::string planner_names_text();
 
 // Every parameter name any planner declares, each once.
-const std::vector<std::string>& all_parameter_names();
+std::vector<std::string> all_parameter_names();
 
 // A planner with `values` checked against its declarations (Error("<name>: must be > 0") for
 // a value out of range, Error("<planner>: no parameter 'x'") for one it does not declare) and
