@@ -530,6 +530,9 @@ TEST(QueryCli, BadLinesGetErrorResultsAndTheOthersStillSucceed) {
                          {"position", {0, 0, -0.01}},
                          {"allowed_links", {"ur5_base_link"}}}}}};
   lines.push_back(foreign.dump());  // line 13
+  json empty_scene = query("empty-scene", f.a, f.b, "boe", 1, true);
+  empty_scene["scene"] = "";
+  lines.push_back(empty_scene.dump());  // line 14
   std::string text;
   for (const std::string& l : lines) text += l + "\n";
   const std::string file = write_temp_file("bad.jsonl", text);
@@ -553,6 +556,7 @@ TEST(QueryCli, BadLinesGetErrorResultsAndTheOthersStillSucceed) {
       {11, "misspelt", {"stop_at_frist: unknown field (did you mean 'stop_at_first'?)"}},
       {12, "no-scene", {"scene: no-such-scene.json"}},
       {13, "foreign", {"scene", "ur5_base_link", "is not a link of robot"}},
+      {14, "empty-scene", {"scene: expected an environment file's name"}},
   };
   ASSERT_EQ(t.results.size(), expected.size()) << "one result per non-empty line\n"
                                                << describe(t.r);

@@ -133,6 +133,7 @@ WorldPtr parse_scene(const JsonField& root, SceneCache* scenes) {
   if (!scenes) f.fail("a scene cannot be named here");
   if (f.value().is_object()) return scenes->inline_scene(f);
   const std::string path = f.string();
+  if (path.empty()) f.fail("expected an environment file's name or an environment object");
   try {
     return scenes->load(path);
   } catch (const Error& e) {
