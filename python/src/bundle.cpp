@@ -99,15 +99,50 @@ py::dict command_of(const py::object& self, int64_t edge) {
   return d;
 }
 
+// The per-edge arrays: read-only NumPy views of the (mapped) datasets.
+void bind_edge_arrays(py::class_<BundleView, View>& c) {
+  c.def_property_readonly(
+       "q0", [](const py::object& s) { return edge_rows(s, false); },
+       "Edge start states, (N, dof), read-only view.")
+      .def_property_readonly(
+          "qf", [](const py::object& s) { return edge_rows(s, true); },
+          "Edge end states, (N, dof), read-only view.")
+      .def_property_readonly(
+          "duration", [](const py::object& s) { return edge_array(s, &BundleView::duration_data); },
+          "Simulated edge durations including settling, s, (N,).")
+      .def_property_readonly(
+          "command_duration",
+          [](const py::object& s) { return edge_array(s, &BundleView::command_duration_data); },
+          "Durations of the velocity commands, s, (N,).")
+      .def_property_readonly(
+          "p_lazy_prop",
+          [](const py::object& s) { return edge_array(s, &BundleView::p_lazy_prop_data); },
+          "P_lazy_prop per edge (N,), or None without a perturbation analysis.")
+      .def_property_readonly(
+          "p_collision",
+          [](const py::object& s) { return edge_array(s, &BundleView::p_collision_data); },
+          "P_collision per edge (N,), or None without a perturbation analysis.")
+      .def_property_readonly(
+          "p_lazy_prop_transfer",
+          [](const py::object& s) { return edge_array(s, &BundleView::p_lazy_prop_transfer_data); },
+          "P_lazy_prop under displacement transfer (N,), or None.")
+      .def_property_readonly(
+          "transfer_max_error",
+          [](const py::object& s) { return edge_array(s, &BundleView::transfer_max_error_data); },
+          "Largest transfer residual per edge, rad (N,), or None.");
+}
+
 }  // namespace
 
 void bind_bundle(py::module_& m) {
-  py::class_<BundleView, View>(
+  py::class_<BundleView, View> bundle(
       m, "Bundle",
       "An edge bundle file, opened read-only. The per-edge arrays (q0, qf, duration, "
       "command_duration, p_lazy_prop, p_collision, p_lazy_prop_transfer, transfer_max_error) "
       "are read-only NumPy views of the memory-mapped file, not copies; they keep the bundle "
-      "open.")
+      "open.");
+  bind_edge_arrays(bundle);
+  bundle
       .def(py::init([](const py::object& path, bool memory_map) {
              const std::string p = py::str(path).cast<std::string>();
              return file_errors(
@@ -136,35 +171,6 @@ void bind_bundle(py::module_& m) {
             return py::float_(v.perturbation_theta());
           },
           "theta of the perturbation analysis, rad; None without one.")
-      .def_property_readonly(
-          "q0", [](const py::object& s) { return edge_rows(s, false); },
-          "Edge start states, (N, dof), read-only view.")
-      .def_property_readonly(
-          "qf", [](const py::object& s) { return edge_rows(s, true); },
-          "Edge end states, (N, dof), read-only view.")
-      .def_property_readonly(
-          "duration", [](const py::object& s) { return edge_array(s, &BundleView::duration_data); },
-          "Simulated edge durations including settling, s, (N,).")
-      .def_property_readonly(
-          "command_duration",
-          [](const py::object& s) { return edge_array(s, &BundleView::command_duration_data); },
-          "Durations of the velocity commands, s, (N,).")
-      .def_property_readonly(
-          "p_lazy_prop",
-          [](const py::object& s) { return edge_array(s, &BundleView::p_lazy_prop_data); },
-          "P_lazy_prop per edge (N,), or None without a perturbation analysis.")
-      .def_property_readonly(
-          "p_collision",
-          [](const py::object& s) { return edge_array(s, &BundleView::p_collision_data); },
-          "P_collision per edge (N,), or None without a perturbation analysis.")
-      .def_property_readonly(
-          "p_lazy_prop_transfer",
-          [](const py::object& s) { return edge_array(s, &BundleView::p_lazy_prop_transfer_data); },
-          "P_lazy_prop under displacement transfer (N,), or None.")
-      .def_property_readonly(
-          "transfer_max_error",
-          [](const py::object& s) { return edge_array(s, &BundleView::transfer_max_error_data); },
-          "Largest transfer residual per edge, rad (N,), or None.")
       .def("command", &command_of, py::arg("edge"),
            "The velocity command of an edge: {'knots': (k, dof) view, 'duration': s}.")
       .def(
