@@ -331,10 +331,8 @@ void write_execution(std::ostream& md, std::map<std::string, PlannerStats>& stat
   }
 }
 
-}  // namespace
-
-std::string summary_markdown(const StudyInfo& info, const std::vector<PlannerSpec>& specs,
-                             const std::vector<RunRecord>& runs) {
+// Each planner's runs gathered for the summary.
+std::map<std::string, PlannerStats> planner_stats(const std::vector<RunRecord>& runs) {
   std::map<std::string, PlannerStats> stats;
   for (const RunRecord& r : runs) {
     PlannerStats& s = stats[r.planner];
@@ -356,6 +354,14 @@ std::string summary_markdown(const StudyInfo& info, const std::vector<PlannerSpe
     s.blends_kept += std::max(0, r.blends_kept);
     s.shortcuts += std::max(0, r.shortcuts);
   }
+  return stats;
+}
+
+}  // namespace
+
+std::string summary_markdown(const StudyInfo& info, const std::vector<PlannerSpec>& specs,
+                             const std::vector<RunRecord>& runs) {
+  std::map<std::string, PlannerStats> stats = planner_stats(runs);
   std::ostringstream md;
   md << "# lazyboe-bench summary\n\n";
   md << "- Bundle: `" << info.bundle << "` (" << info.edges << " edges), robot `" << info.robot

@@ -190,6 +190,20 @@ bool prepare_perturbation(Bundle& b, const PerturbSettings& s, bool replace,
   return false;
 }
 
+// One edge's counts of a round, into the analysis.
+static void apply_counts(const EdgePerturbationCounts& c, size_t e, Perturbation& p) {
+  p.done[e] = c.done;
+  p.valid[e] = c.valid;
+  p.lazy[e] = c.lazy;
+  p.collision[e] = c.collision;
+  p.max_error[e] = c.valid ? c.max_error : std::numeric_limits<double>::quiet_NaN();
+  p.transfer_lazy[e] = c.transfer_lazy;
+  p.transfer_max_error[e] =
+      c.valid ? c.transfer_max_error : std::numeric_limits<double>::quiet_NaN();
+  p.simulated_seconds += c.simulated_seconds;
+  set_probabilities(p, e);
+}
+
 PerturbOutcome run_perturbation(const Simulator& sim, Bundle& b, const PerturbSettings& s,
                                 const PerturbControl& control) {
   Perturbation& p = b.perturbation;
@@ -253,20 +267,7 @@ PerturbOutcome run_perturbation(const Simulator& sim, Bundle& b, const PerturbSe
       for (size_t k = 0; k < count; ++k) counts[k] = counts_so_far(p, round_list[k]);
       control.run_round(round_list, counts);
     }
-    for (size_t k = 0; k < count; ++k) {
-      const size_t e = pending[start + k];
-      const EdgePerturbationCounts& c = counts[k];
-      p.done[e] = c.done;
-      p.valid[e] = c.valid;
-      p.lazy[e] = c.lazy;
-      p.collision[e] = c.collision;
-      p.max_error[e] = c.valid ? c.max_error : std::numeric_limits<double>::quiet_NaN();
-      p.transfer_lazy[e] = c.transfer_lazy;
-      p.transfer_max_error[e] =
-          c.valid ? c.transfer_max_error : std::numeric_limits<double>::quiet_NaN();
-      p.simulated_seconds += c.simulated_seconds;
-      set_probabilities(p, e);
-    }
+    for (size_t k = 0; k < count; ++k) apply_counts(counts[k], pending[start + k], p);
     applied = start + count;
     finished += count;
     progress.update(finished);
