@@ -95,7 +95,8 @@ TEST(Checkpoints, FinishedFileIsTheSameBytesWithOrWithoutCheckpoints) {
   const CommandResult r = tool("lazyboe-build", build_args(out, "0"));
   ASSERT_EQ(r.exit_code, 0) << describe(r);
   EXPECT_TRUE(same_bundle_but_timings(out, reference_build(), 1));
-  EXPECT_EQ(files_in(dir), (std::vector<std::string>{"run.h5", "run.h5.kd-index"}))
+  EXPECT_EQ(files_in(dir),
+            (std::vector<std::string>{"run.h5", "run.h5.kd-index", "run.h5.ws-index"}))
       << "the journal is removed";
   const std::string perturbed = dir + "/perturbed.h5";
   fs::copy_file(reference_build(), perturbed);

@@ -92,7 +92,8 @@ TEST(FullDisk, ResumedBuildPastTheLimitKeepsTheLastCheckpoint) {
       limit);
   expect_one_line_error(r, {out + ": cannot write", "File too large"});
   EXPECT_EQ(read_file(out), before);
-  EXPECT_EQ(files_in(dir), (std::vector<std::string>{"out.h5", "out.h5.kd-index"}));
+  EXPECT_EQ(files_in(dir),
+            (std::vector<std::string>{"out.h5", "out.h5.kd-index", "out.h5.ws-index"}));
 }
 
 TEST(FullDisk, PerturbPastTheLimitKeepsTheBundle) {
@@ -107,7 +108,7 @@ TEST(FullDisk, PerturbPastTheLimitKeepsTheBundle) {
            limit);
   expect_one_line_error(r, {out + ": cannot write", "File too large"});
   EXPECT_EQ(read_file(out), before);
-  EXPECT_EQ(files_in(dir), (std::vector<std::string>{"b.h5", "b.h5.kd-index"}));
+  EXPECT_EQ(files_in(dir), (std::vector<std::string>{"b.h5", "b.h5.kd-index", "b.h5.ws-index"}));
 }
 
 // ---- an output is never an input --------------------------------------------------------

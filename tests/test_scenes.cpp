@@ -306,6 +306,56 @@ TEST(Scenes, ASessionKeepsItsScenesByContent) {
   EXPECT_TRUE(here.result.success) << here.result.failure;
 }
 
+// The workspace index (written by lazyboe-build) steers lazysp in a new scene; the answer is
+// still simulated in it, so it goes around the ball. In the bundle's own scene the index
+// changes nothing: the same answers with and without it.
+TEST(Scenes, LazyspPlansWithTheWorkspaceIndexInANewScene) {
+  const Fixture& f = fixture();
+  ASSERT_TRUE(f.session.workspace.index) << f.session.workspace.source;
+  const json open = run_queries("index-open", {query("open")}).at(0);
+  ASSERT_TRUE(open.value("success", false)) << open.dump().substr(0, 600);
+  const json scene = blocked_scene(open, kBall);
+  const WorldPtr world = f.session.scenes.inline_scene(JsonField(scene, "ball", ""));
+  ASSERT_TRUE(world->edge_marks);
+  EXPECT_GT(world->edge_marks->marked, 0u);
+  EXPECT_LT(world->edge_marks->marked, f.session.bundle.size());
+
+  const std::string scene_file = write_temp_file("scenes/index-ball.json", scene.dump(2));
+  json q = query("lazysp");
+  q["planner"] = "lazysp";
+  q["scene"] = scene_file;
+  const json r = run_queries("index-lazysp", {q}).at(0);
+  ASSERT_TRUE(r.value("success", false)) << r.dump().substr(0, 600);
+  const CheckCounts c = check_samples("index-lazysp", r, scene_file);
+  EXPECT_GT(c.rows, 0);
+  EXPECT_EQ(c.env_collisions, 0);
+
+  const std::string bare = fresh_dir("scenes-no-index") + "/bundle.h5";
+  fs::copy_file(f.path, bare);
+  json own = query("own");
+  own["planner"] = "lazysp";
+  std::string text = own.dump() + "\n";
+  own["seed"] = 4;
+  own["id"] = "own-4";
+  text += own.dump() + "\n";
+  const std::string file = write_temp_file("scenes/own.jsonl", text);
+  std::vector<json> answers;
+  for (const std::string& bundle : {f.path, bare}) {
+    const CommandResult run_r =
+        run(watchdog(300) + quote(tool_path("lazyboe-query")) + " --bundle " + quote(bundle) +
+            " --queries " + quote(file) + " --trajectories inline");
+    ASSERT_EQ(run_r.exit_code, 0) << describe(run_r);
+    EXPECT_NE(run_r.err.find(bundle == bare ? "workspace index none" : "workspace index mapped"),
+              std::string::npos)
+        << run_r.err;
+    answers.push_back(json::array());
+    std::istringstream in(run_r.out);
+    for (std::string line; std::getline(in, line);)
+      answers.back().push_back(timeless(json::parse(line)));
+  }
+  EXPECT_EQ(answers[0], answers[1]);
+}
+
 TEST(Scenes, AnEnvironmentForAnotherRobotIsRefusedWithOneLine) {
   json scene = table_scene();
   scene["objects"][0]["allowed_links"] = {"base_link", "shoulder_link"};  // a UR5's

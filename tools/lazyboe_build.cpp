@@ -11,10 +11,13 @@
 #include "lazyboe/bundle/bundle_file.h"
 #include "lazyboe/bundle/checkpoint_journal.h"
 #include "lazyboe/bundle/inspect.h"
+#include "lazyboe/bundle/scene.h"
 #include "lazyboe/common/file_checks.h"
 #include "lazyboe/common/json_fields.h"
+#include "lazyboe/common/progress.h"
 #include "lazyboe/common/version.h"
 #include "lazyboe/planning/edge_index_file.h"
+#include "lazyboe/planning/workspace_index.h"
 #include "mpi_build.h"
 #include "mpi_offline.h"
 #include "tool_main.h"
@@ -91,6 +94,7 @@ struct BuildOptions {
   BuildSettings settings;
   BuildControl control;
   double sample_interval = 0.05;
+  double workspace_cell = WorkspaceIndexOptions().cell;
   bool resume = false, force = false, mpi = false;
 };
 
@@ -156,8 +160,11 @@ void add_options(CLI::App& app, BuildOptions& o) {
   app.add_option("--verify", o.verify_path,
                  "Check every dataset's checksum and the bundle's validity, then exit");
   app.add_option("--index", o.index_path,
-                 "Write the k-d tree index beside a finished bundle (FILE.kd-index; every build "
-                 "writes one), then exit");
+                 "Write the k-d tree index and the workspace index beside a finished bundle "
+                 "(FILE.kd-index, FILE.ws-index; every build writes them), then exit");
+  app.add_option("--workspace-cell", o.workspace_cell,
+                 "Cell side of the workspace index, m (docs/bundle.md)")
+      ->check(CLI::Range(0.005, 1.0));
 }
 
 // Checks the options that need no file, in the order of their messages' precedence.
@@ -251,25 +258,48 @@ void report_replay(const JournalReplay& r, const Bundle& b, const BuildOptions& 
                  r.ignored_bytes ? "; a torn last checkpoint was dropped" : "");
 }
 
-// The k-d tree index beside a finished bundle, so that planning maps its trees instead of
-// building them at load.
-void write_index(const std::string& path, bool quiet) {
-  const auto started = std::chrono::steady_clock::now();
-  write_bundle_index(BundleView::open(path));
-  if (quiet) return;
-  std::fprintf(stderr, "lazyboe-build: k-d tree index written to %s (%.2f s)\n",
-               edge_index_path(path).c_str(),
-               std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count());
+double seconds_since(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
 }
 
-// After a finished build the index is a convenience: failing to write it leaves a good bundle.
-void try_write_index(const std::string& path, bool quiet) {
+// The workspace index beside a finished bundle (workspace_index.h), with progress.
+void write_workspace(const BundleView& bundle, double cell, bool quiet) {
+  const auto started = std::chrono::steady_clock::now();
+  WorkspaceIndexOptions options;
+  options.cell = cell;
+  Progress progress("workspace index", bundle.size(), quiet);
+  options.progress = [&](size_t done) { progress.update(done); };
+  const RobotModel robot = load_bundle_robot(bundle.header(), "");
+  const WorkspaceIndexSummary s = write_workspace_index(bundle, robot, options);
+  progress.finish();
+  if (quiet) return;
+  std::fprintf(
+      stderr, "lazyboe-build: workspace index written to %s (cell %.3f m, %.1f MB, %.2f s)\n",
+      workspace_index_path(bundle.path()).c_str(), cell, s.bytes / 1e6, seconds_since(started));
+}
+
+// The indexes beside a finished bundle: the k-d trees, so that planning maps them instead of
+// building them at load, and the workspace index, so that a new scene gets its collision prior.
+void write_index(const std::string& path, double cell, bool quiet) {
+  const auto started = std::chrono::steady_clock::now();
+  const BundleView bundle = BundleView::open(path);
+  write_bundle_index(bundle);
+  if (!quiet)
+    std::fprintf(stderr, "lazyboe-build: k-d tree index written to %s (%.2f s)\n",
+                 edge_index_path(path).c_str(), seconds_since(started));
+  write_workspace(bundle, cell, quiet);
+}
+
+// After a finished build the indexes are a convenience: failing to write them leaves a good
+// bundle.
+void try_write_index(const std::string& path, double cell, bool quiet) {
   try {
-    write_index(path, quiet);
+    write_index(path, cell, quiet);
   } catch (const std::exception& e) {  // Error, or the file system's own
     std::fprintf(stderr,
-                 "lazyboe-build: warning: %s; planning will build the k-d trees at load "
-                 "(write the index later with lazyboe-build --index %s)\n",
+                 "lazyboe-build: warning: %s; planning will build the k-d trees at load and "
+                 "plan in other scenes without a collision prior (write the indexes later with "
+                 "lazyboe-build --index %s)\n",
                  e.what(), path.c_str());
   }
 }
@@ -313,7 +343,7 @@ int grow_bundle(const Simulator& sim, BuildOptions& o, Bundle& bundle,
                  o.out_path.c_str(), bundle.size(), o.out_path.c_str());
     return 130;
   }
-  try_write_index(o.out_path, o.control.quiet);
+  try_write_index(o.out_path, o.workspace_cell, o.control.quiet);
   return 0;
 }
 
@@ -340,7 +370,7 @@ int verify(const std::string& path) {
 int run(const CLI::App& app, BuildOptions& o) {
   if (!o.verify_path.empty()) return verify(o.verify_path);
   if (!o.index_path.empty()) {
-    write_index(o.index_path, false);
+    write_index(o.index_path, o.workspace_cell, false);
     return 0;
   }
   if (!o.inspect_path.empty()) {
@@ -384,8 +414,9 @@ int run(const CLI::App& app, BuildOptions& o) {
     check_resume_compatible(existing.header, bundle.header, o.out_path);
     if (!prepare_resume(existing, o)) {  // complete already: only its index may be missing
       std::error_code error;
-      if (!std::filesystem::exists(edge_index_path(o.out_path), error))
-        try_write_index(o.out_path, o.control.quiet);
+      if (!std::filesystem::exists(edge_index_path(o.out_path), error) ||
+          !std::filesystem::exists(workspace_index_path(o.out_path), error))
+        try_write_index(o.out_path, o.workspace_cell, o.control.quiet);
       return 0;
     }
     bundle = std::move(existing);

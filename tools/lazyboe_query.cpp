@@ -119,6 +119,11 @@ void report_load(const Options& o, const PlanningSession& session) {
       o.bundle_path.c_str(), bundle.size(), session.load_seconds,
       bundle.memory_mapped() ? "memory-mapped" : "read into memory", resident_memory_mib());
   std::fprintf(stderr, "lazyboe-query: k-d trees %s\n", session.indexes.source.c_str());
+  std::fprintf(stderr, "lazyboe-query: workspace index %s\n", session.workspace.source.c_str());
+  if (const EdgeMarks* marks = session.world().edge_marks.get())
+    std::fprintf(
+        stderr, "lazyboe-query: scene %s: %zu of %zu edges may collide (marked in %.1f ms)\n",
+        session.world().env.name.c_str(), marks->marked, bundle.size(), 1e3 * marks->seconds);
 }
 
 // A query id names its trajectory file: it must stay inside --trajectory-dir.

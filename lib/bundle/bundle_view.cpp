@@ -110,13 +110,14 @@ BundleView BundleView::open(const std::string& path, bool allow_mmap) {
   if (knot_shape.size() != 2 || knot_shape[1] != dof)
     fail(path, std::string(ds::knots) + ": expected K x dof");
   v.knots_ = v.attach<double>(file, ds::knots, knot_shape, allow_mmap);
-  // The sample offsets are checked like every reader checks them (the samples themselves are
-  // never read by the planners: read_bundle and --verify check them).
+  // The sample offsets are checked like every reader checks them (the samples' values are
+  // never used to plan: read_bundle and --verify check them; the workspace index reads them).
   const std::vector<uint64_t> sample_shape = h5::dataset_shape(path, file, ds::sample_q);
   if (sample_shape.size() != 2 || sample_shape[1] != dof)
     fail(path, std::string(ds::sample_q) + ": expected S x dof");
   const uint64_t sample_rows = sample_shape[0];
-  const uint64_t* sample_offset = v.attach<uint64_t>(file, ds::sample_offset, {n + 1}, allow_mmap);
+  v.sample_offset_ = v.attach<uint64_t>(file, ds::sample_offset, {n + 1}, allow_mmap);
+  v.sample_q_ = v.attach<float>(file, ds::sample_q, sample_shape, allow_mmap);
   v.check_knot_ranges(knot_shape[0]);
   if (h5::exists(file, ds::perturbation)) {
     h5::Group g(H5Gopen2(file, ds::perturbation, H5P_DEFAULT));
@@ -133,7 +134,7 @@ BundleView BundleView::open(const std::string& path, bool allow_mmap) {
       }
     }
   }
-  v.check_values(knot_shape[0], sample_rows, sample_offset);
+  v.check_values(knot_shape[0], sample_rows, v.sample_offset_);
   return v;
 }
 
@@ -153,6 +154,8 @@ BundleView BundleView::from_memory(std::shared_ptr<const Bundle> bundle, std::st
   v.command_duration_ = b.command_duration.data();
   v.knot_offset_ = b.knot_offset.data();
   v.knots_ = b.knots.data();
+  v.sample_offset_ = b.sample_offset.data();
+  v.sample_q_ = b.sample_q.data();
   v.check_knot_ranges(b.knots.size() / static_cast<size_t>(b.dof()));
   const Perturbation& p = b.perturbation;
   if (p.present && v.use_perturbation(p.complete)) {

@@ -60,6 +60,11 @@ class BundleView {
   const double* p_lazy_prop_transfer_data() const { return p_lazy_prop_transfer_; }
   const double* transfer_max_error_data() const { return transfer_max_error_; }
 
+  // The stored trajectory samples of an edge: sample_count(edge) rows of dof floats, the states
+  // every sample_interval of the header and the end state (none when it is 0).
+  size_t sample_count(size_t edge) const { return sample_offset_[edge + 1] - sample_offset_[edge]; }
+  const float* samples(size_t edge) const { return sample_q_ + sample_offset_[edge] * dof(); }
+
   bool memory_mapped() const { return all_mapped_; }  // every dataset mapped
   // The checksums stored with the q0 and qf datasets, "<q0> <qf>": what ties an index file
   // (edge_index_file.h) to these edge states. Empty for a file written before checksums and
@@ -94,6 +99,8 @@ class BundleView {
   const double* command_duration_ = nullptr;
   const uint64_t* knot_offset_ = nullptr;
   const double* knots_ = nullptr;
+  const uint64_t* sample_offset_ = nullptr;
+  const float* sample_q_ = nullptr;
   const double* p_lazy_prop_ = nullptr;
   const double* p_collision_ = nullptr;
   const double* p_lazy_prop_transfer_ = nullptr;

@@ -1,11 +1,5 @@
 #include "lazyboe/planning/edge_index_file.h"
 
-#include <fcntl.h>
-#include <sys/mman.h>
-#include <sys/stat.h>
-#include <unistd.h>
-
-#include <cerrno>
 #include <cstring>
 #include <filesystem>
 #include <vector>
@@ -15,6 +9,8 @@
 #include "lazyboe/common/atomic_file.h"
 #include "lazyboe/common/error.h"
 #include "lazyboe/common/hash.h"
+#include "lazyboe/planning/index_file.h"
+#include "lazyboe/planning/workspace_index.h"
 
 namespace lazyboe {
 
@@ -70,69 +66,13 @@ KdTreeArrays tree_at(const char* p, uint64_t edges, int dof, uint64_t nodes) {
   return t;
 }
 
-struct FileBytes {
-  std::shared_ptr<const void> storage;
-  const char* data = nullptr;
-  size_t size = 0;
-};
-
-// The whole file, mapped read-only or read. Throws Error naming it when it cannot be, or is
-// not a regular file (opened without blocking: a FIFO there must not hang the session).
-FileBytes file_bytes(const std::string& path, bool memory_map) {
-  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
-  if (fd < 0) fail(path, std::string("cannot open: ") + std::strerror(errno));
-  const auto refuse = [&](const std::string& why) {
-    ::close(fd);
-    fail(path, why);
-  };
-  struct stat st {};
-  if (::fstat(fd, &st) != 0) refuse(std::string("cannot stat: ") + std::strerror(errno));
-  if (!S_ISREG(st.st_mode)) refuse("not a regular file");
-  if (st.st_size < static_cast<off_t>(kHeaderBytes)) refuse("truncated or malformed");
-  FileBytes f;
-  f.size = static_cast<size_t>(st.st_size);
-  if (memory_map) {
-    void* map = ::mmap(nullptr, f.size, PROT_READ, MAP_SHARED, fd, 0);
-    if (map == MAP_FAILED) refuse(std::string("cannot memory-map: ") + std::strerror(errno));
-    f.storage = std::shared_ptr<const void>(map, FileUnmap{f.size});
-    f.data = static_cast<const char*>(map);
-  } else {
-    auto bytes = std::make_shared<std::string>(f.size, '\0');
-    for (size_t done = 0; done < f.size;) {
-      const ssize_t n = ::pread(fd, bytes->data() + done, f.size - done, static_cast<off_t>(done));
-      if (n <= 0 && !(n < 0 && errno == EINTR))
-        refuse(n < 0 ? std::string("cannot read: ") + std::strerror(errno) : "truncated");
-      if (n > 0) done += static_cast<size_t>(n);
-    }
-    f.data = bytes->data();
-    f.storage = std::move(bytes);
-  }
-  ::close(fd);  // a mapping stays valid
-  return f;
-}
-
-// What ties an index to the bundle's edge states: the checksums stored with q0 and qf, or for a
-// file written before checksums the same FNV-1a 64 computed from their bytes (one pass over them).
-std::string states_fingerprint(const BundleView& bundle) {
-  if (!bundle.states_checksum().empty()) return bundle.states_checksum();
-  const size_t bytes = bundle.size() * static_cast<size_t>(bundle.dof()) * sizeof(double);
-  std::string out;
-  for (const double* rows :
-       {bundle.size() ? bundle.q0(0) : nullptr, bundle.size() ? bundle.qf(0) : nullptr}) {
-    Fnv1a64 hash;
-    hash.update(rows, rows ? bytes : 0);
-    out += (out.empty() ? "" : " ") + std::string(kChecksumPrefix) + hash.hex();
-  }
-  return out;
-}
-
 // Why the header does not describe an index of `bundle` in a file of `size` bytes; "" if it does.
 std::string mismatch(const IndexHeader& h, const BundleView& bundle, size_t size) {
   if (std::memcmp(h.magic, kMagic, sizeof kMagic) != 0) return "not a k-d tree index";
   if (h.version != kVersion) return "index format version " + std::to_string(h.version);
   const std::string stored(h.states_checksum, strnlen(h.states_checksum, sizeof h.states_checksum));
   if (h.dof != static_cast<uint32_t>(bundle.dof()) || h.edges != bundle.size() ||
-      stored != states_fingerprint(bundle))
+      stored != bundle_states_fingerprint(bundle))
     return "made for other edge states than the bundle's (rewrite it with lazyboe-build --index)";
   const uint64_t limit = 2 * h.edges + 1;  // what the tree check accepts
   if (h.node_count[0] > limit || h.node_count[1] > limit ||
@@ -144,7 +84,7 @@ std::string mismatch(const IndexHeader& h, const BundleView& bundle, size_t size
 
 // The index at `path` for `bundle`; throws Error saying why it cannot be used.
 BundleIndexes open_index(const BundleView& bundle, const std::string& path, bool memory_map) {
-  const FileBytes f = file_bytes(path, memory_map);
+  const IndexFileBytes f = read_index_file(path, memory_map, kHeaderBytes);
   IndexHeader h;
   std::memcpy(&h, f.data, sizeof h);
   const std::string why = mismatch(h, bundle, f.size);
@@ -196,8 +136,11 @@ std::string bundle_index_status(const BundleView& bundle) {
 
 void print_files_beside(const std::string& path, std::FILE* out) {
   std::vector<std::string> lines;
-  if (read_bundle_header(path).complete)
-    lines.push_back("k-d tree index: " + bundle_index_status(BundleView::open(path)));
+  if (read_bundle_header(path).complete) {
+    const BundleView bundle = BundleView::open(path);
+    lines.push_back("k-d tree index: " + bundle_index_status(bundle));
+    lines.push_back("workspace index: " + workspace_index_status(bundle));
+  }
   for (const std::string& journal : {build_journal_path(path), perturb_journal_path(path)}) {
     std::error_code error;
     const uintmax_t bytes = std::filesystem::file_size(journal, error);
@@ -211,7 +154,7 @@ void print_files_beside(const std::string& path, std::FILE* out) {
 
 void write_bundle_index(const BundleView& bundle) {
   const std::string path = edge_index_path(bundle.path());
-  const std::string states = states_fingerprint(bundle);
+  const std::string states = bundle_states_fingerprint(bundle);
   IndexHeader h{};
   if (states.size() >= sizeof h.states_checksum) fail(path, "unexpected checksum " + states);
   const EdgeIndex starts(bundle, EdgePoint::Start), ends(bundle, EdgePoint::End);

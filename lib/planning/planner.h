@@ -10,6 +10,7 @@
 #include "lazyboe/bundle/bundle_view.h"
 #include "lazyboe/planning/neighbour_index.h"
 #include "lazyboe/planning/problem.h"
+#include "lazyboe/planning/workspace_index.h"
 #include "lazyboe/sim/command_profile.h"
 #include "lazyboe/sim/rollout_pool.h"
 
@@ -32,7 +33,19 @@ struct PlanningContext {
   double mean_displacement = 0;            // mean |qf - q0| of the bundle's edges, rad (0: none)
   JointVector sample_lower, sample_upper;  // state sampling box
   CommandSampling command;                 // control family of the sampling planners
+  // The bundle edges the world may block (its workspace-index marks), when the world is not the
+  // bundle's own scene; null: the bundle's P_collision (its build scene's) is the prior.
+  const EdgeMarks* scene_marks = nullptr;
 };
+
+// The prior probability that bundle edge `e` collides in the context's world: 1 for an edge an
+// obstacle new to the bundle may block (the world's workspace-index marks), otherwise the edge's
+// P_collision from the bundle's perturbation analysis (its build scene's obstacles; 0 without an
+// analysis). It steers the searches; simulation decides.
+inline double collision_prior(const PlanningContext& c, size_t e) {
+  if (c.scene_marks && c.scene_marks->may_collide(e)) return 1.0;
+  return c.bundle->has_perturbation() ? c.bundle->p_collision(e) : 0.0;
+}
 
 class Planner {
  public:

@@ -13,10 +13,45 @@ SimulationOptions unsampled(SimulationOptions options) {
   return options;
 }
 
+// Is `env` the scene the bundle was built in (its files hash to the recorded content)?
+bool is_build_scene(const Environment& env, const std::string& build_hash) {
+  if (env.path.empty()) return false;
+  try {
+    return environment_identity(env) == build_hash;
+  } catch (const std::exception&) {  // a file no longer readable: not provably the same
+    return false;
+  }
+}
+
+// The scene the bundle was built in, when its file is still there (else none: every obstacle of
+// a new scene then marks).
+std::shared_ptr<const Environment> build_scene(const BundleHeader& h) {
+  try {
+    return std::make_shared<const Environment>(load_bundle_environment(h, ""));
+  } catch (const std::exception&) {
+    return nullptr;
+  }
+}
+
+// A new world's marks from the session's workspace index, for the obstacles the build scene did
+// not have (the bundle's P_collision covers those it had); none in the build scene itself.
+EdgeMarker session_marker(const WorkspaceIndexLoad& workspace, const RobotModel& robot,
+                          const BundleHeader& h) {
+  if (!workspace.index) return {};
+  return [index = workspace.index, &robot, build_hash = h.env_hash, known = build_scene(h)](
+             const Environment& env,
+             const CollisionModel& collision) -> std::shared_ptr<const EdgeMarks> {
+    if (is_build_scene(env, build_hash)) return nullptr;
+    return std::make_shared<const EdgeMarks>(
+        mark_edges(*index, robot, env, collision, known.get()));
+  };
+}
+
 WorldPtr default_world(const BundleHeader& h, const RobotModel& robot,
-                       const SimulationOptions& options, const std::string& env_path) {
+                       const SimulationOptions& options, const std::string& env_path,
+                       const EdgeMarker& marker) {
   Environment env = env_path.empty() ? load_bundle_environment(h, "") : load_environment(env_path);
-  return std::make_shared<const PlanningWorld>(robot, std::move(env), options);
+  return std::make_shared<const PlanningWorld>(robot, std::move(env), options, marker);
 }
 
 }  // namespace
@@ -27,8 +62,11 @@ PlanningSession::PlanningSession(const std::string& bundle_path, bool memory_map
       bundle(BundleView::open(bundle_path, memory_map)),
       robot(load_bundle_robot(bundle.header(), robot_path)),
       settings(settings_from_header(bundle.header())),
+      workspace(load_workspace_index(bundle, robot, memory_map)),
       scenes(robot, unsampled(settings.simulation),
-             default_world(bundle.header(), robot, unsampled(settings.simulation), env_path)),
+             default_world(bundle.header(), robot, unsampled(settings.simulation), env_path,
+                           session_marker(workspace, robot, bundle.header())),
+             session_marker(workspace, robot, bundle.header())),
       indexes(load_bundle_indexes(bundle, memory_map)),
       index(indexes.starts),
       end_index(indexes.ends),
@@ -70,7 +108,9 @@ PlanningContext bundle_context(const Simulator& sim, const BundleView& bundle,
 }
 
 PlanningContext PlanningSession::context(const PlanningWorld& w) const {
-  return bundle_context(w.sim, bundle, index, &end_index, mean_displacement);
+  PlanningContext c = bundle_context(w.sim, bundle, index, &end_index, mean_displacement);
+  c.scene_marks = w.edge_marks.get();
+  return c;
 }
 
 double resident_memory_mib() {

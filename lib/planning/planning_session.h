@@ -18,6 +18,7 @@
 #include "lazyboe/planning/neighbour_index.h"
 #include "lazyboe/planning/planner.h"
 #include "lazyboe/planning/scene_cache.h"
+#include "lazyboe/planning/workspace_index.h"
 
 namespace lazyboe {
 
@@ -56,6 +57,9 @@ class PlanningSession {
   const BundleView bundle;
   const RobotModel robot;        // the bundle's, checked by content hash
   const BuildSettings settings;  // the bundle's simulation, command and region settings
+  // The edge-to-workspace index beside the bundle (workspace_index.h): each world other than
+  // the bundle's own scene gets its edge marks from it when it is made.
+  const WorkspaceIndexLoad workspace;
   // The worlds planned in (world.h): the default, and scenes queries name (by content).
   mutable SceneCache scenes;
   const BundleIndexes indexes;     // where they come from: indexes.source

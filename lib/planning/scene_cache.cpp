@@ -3,10 +3,11 @@
 namespace lazyboe {
 
 SceneCache::SceneCache(const RobotModel& robot, const SimulationOptions& options,
-                       WorldPtr default_world, size_t capacity)
+                       WorldPtr default_world, EdgeMarker marker, size_t capacity)
     : robot_(robot),
       options_(options),
       default_world_(std::move(default_world)),
+      marker_(std::move(marker)),
       capacity_(capacity) {}
 
 WorldPtr SceneCache::load(const std::string& path) { return world(load_environment(path)); }
@@ -32,7 +33,7 @@ WorldPtr SceneCache::world(Environment env) {
   }
   // Built outside the lock (FCL's geometry can take milliseconds); of two threads that built
   // one new scene at once, the first to come back is kept and given to both.
-  auto made = std::make_shared<const PlanningWorld>(robot_, std::move(env), options_);
+  auto made = std::make_shared<const PlanningWorld>(robot_, std::move(env), options_, marker_);
   const std::lock_guard<std::mutex> lock(mutex_);
   if (WorldPtr known = find(made->env.identity)) return known;
   recent_.push_front(made);

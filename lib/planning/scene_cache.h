@@ -16,8 +16,9 @@ namespace lazyboe {
 
 class SceneCache {
  public:
+  // `marker`: how each new world learns the edges it may block (world.h).
   SceneCache(const RobotModel& robot, const SimulationOptions& options, WorldPtr default_world,
-             size_t capacity = 16);
+             EdgeMarker marker = {}, size_t capacity = 16);
 
   const WorldPtr& default_world() const { return default_world_; }
   // The world of an environment file (errors name the file and field).
@@ -33,6 +34,7 @@ class SceneCache {
   const RobotModel& robot_;
   const SimulationOptions options_;
   const WorldPtr default_world_;
+  const EdgeMarker marker_;
   const size_t capacity_;
   std::mutex mutex_;
   std::list<WorldPtr> recent_;  // most recently used first

@@ -115,6 +115,7 @@ class PlanningSession:
     bundle: Bundle
     load_seconds: float
     index_source: str
+    workspace_index_source: str
     default_theta: float
     scene: dict[str, str]
     def __init__(self, bundle_path: Path, memory_map: bool = True, robot: Optional[Path] = None,

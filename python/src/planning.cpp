@@ -458,6 +458,11 @@ void bind_session_properties(py::class_<Session>& c) {
           "Where the k-d trees came from: 'mapped from <bundle>.kd-index', 'read from ...' "
           "(memory_map=False), or 'built at load (why)'.")
       .def_property_readonly(
+          "workspace_index_source", [](const Session& s) { return s.session->workspace.source; },
+          "Where the workspace index came from ('mapped from <bundle>.ws-index', ...), or why "
+          "there is none in use: without it, scenes other than the bundle's get no collision "
+          "prior.")
+      .def_property_readonly(
           "default_theta", [](const Session& s) { return s.session->default_theta(); },
           "theta of the bundle's perturbation analysis (or its design theta).");
 }

@@ -83,3 +83,15 @@ def test_load_scene_errors(session, tmp_path):
         session.load_scene(tmp_path / "nothing.json")
     with pytest.raises(ValueError, match="env.objects"):
         session.load_scene({"schema_version": 1, "name": "x"})
+
+
+def test_the_workspace_index_steers_lazysp_in_another_scene(session, bundle_path):
+    # lazyboe-build wrote it beside the bundle; the session maps it, and a scene other than the
+    # bundle's (empty) gets its marks: the same answer as a session opened in that scene.
+    assert session.workspace_index_source == f"mapped from {bundle_path}.ws-index"
+    kwargs = dict(planner="lazysp", seed=3, budget=20, stop_at_first=True)
+    mixed = session.plan(START, {"q": GOAL, "tolerance": 0.1}, scene=TABLE, **kwargs)
+    alone = lazyboe.PlanningSession(bundle_path, env=TABLE).plan(
+        START, {"q": GOAL, "tolerance": 0.1}, **kwargs)
+    assert mixed.success
+    assert without_timings(mixed.to_dict()) == without_timings(alone.to_dict())

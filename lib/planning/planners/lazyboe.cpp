@@ -61,7 +61,7 @@ class LazySearch : public BundleSearch {
     if (!lazy_search_) return;
     for (size_t k = 0; k < neighbours.size(); ++k) {
       const uint32_t e = neighbours[k].first;
-      take_lazy_[k] = rng_.uniform() < (1 - bundle_.p_collision(e)) * p_lazy_prop(e);
+      take_lazy_[k] = rng_.uniform() < (1 - collision_prior(ctx_, e)) * p_lazy_prop(e);
     }
   }
 

@@ -22,11 +22,17 @@ constexpr uint64_t kStream = 2;  // LazyBoE draws from stream 0, RRT and SST fro
 // (a k-d tree query and its successors; measured on the 100k table bundle, ~1 ms vs ~20 us).
 constexpr double kExpansionsPerRollout = 50;
 constexpr double kHeadStart = 50;  // rollouts' worth of lazy work before growth gets a turn
-constexpr double kLazyShare = 3;   // then lazy work may be up to 3x the growth's
+constexpr double kLazyShare = 3;   // then lazy work may be up to 3x the growth's,
+// divided by 1 + (failed candidates) / this: where the scene keeps blocking what the bundle
+// predicts, the growth gets most of the work, as RRT would.
+constexpr double kFailuresPerShare = 20;
+// Expansions of a round's first search in a scene other than the bundle's, with the scene's
+// marks in the edge cost, before the round searches without them.
+constexpr size_t kMarkedSearchLimit = 1000;
 
 struct Settings {
   double theta = 0, epsilon = 2, resolution = 0.05, risk_weight = 0.5, edge_penalty = 0.3,
-         goal_bias = 0.05;
+         goal_bias = 0.05, mark_weight = 2;
   size_t expansion_limit = 20000;
 };
 
@@ -65,10 +71,11 @@ class LazySpSearch {
  private:
   bool lazy_turn();
   void lazy_round();
-  int search(size_t& expansions);
+  bool candidate(size_t& expansions, size_t limit, bool use_marks, std::vector<Predicted>& chain);
+  int search(size_t& expansions, size_t limit);
   int expand(int p);
   bool push(Predicted x, double h);
-  void validate(int goal);
+  bool validate(const std::vector<Predicted>& chain);
   void grow();
   int add_real(const JointVector& q, int parent, int64_t edge, int command, double cost);
   void found(int node, const char* by);
@@ -76,8 +83,12 @@ class LazySpSearch {
   bool prunable(double g, double h);
   bool within_limits(const JointVector& q) const;
   uint64_t cell(const JointVector& q) const;
+  // The bundle's P_collision (its build scene's), and in the second search of a round the
+  // scene's marks too.
   double risk(uint32_t e) const {
-    return bundle_.has_perturbation() ? set_.risk_weight * bundle_.p_collision(e) : 0.0;
+    const double stored = bundle_.has_perturbation() ? bundle_.p_collision(e) : 0.0;
+    const bool marked = use_marks_ && ctx_.scene_marks->may_collide(e);
+    return set_.risk_weight * stored + (marked ? set_.mark_weight : 0.0);
   }
   static uint64_t key(int v, uint32_t e) { return (static_cast<uint64_t>(v) << 32) | e; }
   static Settings settings_of(double theta, const ParameterValues& v) {
@@ -87,6 +98,7 @@ class LazySpSearch {
             v.get("risk_weight"),
             v.get("edge_penalty"),
             v.get("goal_bias"),
+            v.get("mark_weight"),
             static_cast<size_t>(v.get("expansion_limit"))};
   }
 
@@ -108,7 +120,10 @@ class LazySpSearch {
   std::unordered_map<uint64_t, double> best_in_cell_;
   // Scheduling, in rollouts' worth of work.
   double lazy_work_ = 0, growth_work_ = 0;
-  bool exhausted_ = false;  // the last round found no candidate
+  bool exhausted_ = false;        // the last round found no candidate
+  bool use_marks_ = false;        // the search costs the scene's marks
+  bool marked_search_ = true;     // rounds still begin with a search that costs them
+  double failed_candidates_ = 0;  // validated without reaching the goal
   size_t reals_at_exhaustion_ = 0;
 };
 
@@ -138,23 +153,47 @@ bool LazySpSearch::lazy_turn() {
   if (!goal_covered_) return false;
   if (exhausted_)
     return s_.result().counters.nodes > reals_at_exhaustion_ && lazy_work_ <= growth_work_;
-  return lazy_work_ <= kHeadStart + kLazyShare * growth_work_;
+  const double share = kLazyShare / (1 + failed_candidates_ / kFailuresPerShare);
+  return lazy_work_ <= kHeadStart + share * growth_work_;
 }
 
+// In a scene other than the bundle's, a candidate that crosses edges the scene may block
+// (workspace-index marks) gets a second opinion: the same search with the marks in the edge cost,
+// given as many expansions again as the first took; its candidate is simulated instead when it
+// crosses fewer marked edges. Costing the marks in every search would let a goal surrounded by
+// marked edges (a shelf's compartment) cost the search a hundred times more expansions.
 void LazySpSearch::lazy_round() {
   const uint64_t rollouts = s_.result().counters.simulations;
   size_t expansions = 0;
-  const int goal = search(expansions);
-  if (goal >= 0) validate(goal);
+  std::vector<Predicted> chain;
+  bool found = false;
+  if (ctx_.scene_marks && marked_search_) {
+    found = candidate(expansions, kMarkedSearchLimit, true, chain);
+    marked_search_ = found;  // once it finds nothing, the goal is enclosed by marked edges
+  }
+  if (!found) found = candidate(expansions, set_.expansion_limit, false, chain);
+  if (found && !validate(chain)) ++failed_candidates_;
   lazy_work_ += static_cast<double>(expansions) / kExpansionsPerRollout +
                 static_cast<double>(s_.result().counters.simulations - rollouts);
-  exhausted_ = goal < 0;
+  exhausted_ = !found;
   reals_at_exhaustion_ = s_.result().counters.nodes;
+}
+
+// A candidate of one search within `limit` expansions in all: its source (a real state) and
+// predicted states, in order; false when there is none.
+bool LazySpSearch::candidate(size_t& expansions, size_t limit, bool use_marks,
+                             std::vector<Predicted>& chain) {
+  use_marks_ = use_marks;
+  const int goal = search(expansions, limit);
+  chain.clear();
+  for (int u = goal; u >= 0; u = preds_[u].parent) chain.push_back(preds_[u]);
+  std::reverse(chain.begin(), chain.end());
+  return goal >= 0;
 }
 
 // Weighted A* (f = g + epsilon h) from every real node at once, each with its real cost, over
 // predicted states; returns the predicted goal state of the candidate, or -1.
-int LazySpSearch::search(size_t& expansions) {
+int LazySpSearch::search(size_t& expansions, size_t limit) {
   preds_.clear();
   open_ = {};
   best_in_cell_.clear();
@@ -169,7 +208,7 @@ int LazySpSearch::search(size_t& expansions) {
     x.real = static_cast<int>(v);
     push(x, n.h);
   }
-  while (!open_.empty() && expansions < set_.expansion_limit) {
+  while (!open_.empty() && expansions < limit) {
     if (expansions % 8 == 0 && s_.out_of_time()) return -1;
     const int p = open_.top().second;
     open_.pop();
@@ -229,26 +268,24 @@ bool LazySpSearch::push(Predicted x, double h) {
 // A failed edge stays tried from that real state; the valid prefix stays in the tree as real
 // nodes, from which the next round plans. A real end farther than theta/2 from its prediction
 // ends the validation: the rest of the candidate was planned from a place the robot is not.
-void LazySpSearch::validate(int goal) {
-  std::vector<int> chain;
-  int u = goal;
-  for (; preds_[u].parent >= 0; u = preds_[u].parent) chain.push_back(u);
-  std::reverse(chain.begin(), chain.end());
-  int r = preds_[u].real;
-  for (const int p : chain) {
-    if (s_.out_of_time()) return;
-    const uint32_t e = preds_[p].edge;
+// True when it reached the goal.
+bool LazySpSearch::validate(const std::vector<Predicted>& chain) {
+  int r = chain.front().real;
+  for (size_t k = 1; k < chain.size(); ++k) {
+    if (s_.out_of_time()) return false;
+    const uint32_t e = chain[k].edge;
     tried_.insert(key(r, e));
     const RolloutResult res = s_.simulate_from(s_.node(r).q, bundle_.command(e));
-    if (!res.valid()) return;
+    if (!res.valid()) return false;
     const int c = add_real(res.qf, r, e, -1, s_.node(r).cost + res.path_length);
     if (s_.in_goal(s_.node(c).h)) {  // really in the goal region: a solution
       found(c, "bundle");
-      return;
+      return true;
     }
-    if ((res.qf - preds_[p].q).norm() > set_.theta / 2) return;
+    if ((res.qf - chain[k].q).norm() > set_.theta / 2) return false;
     r = c;
   }
+  return false;
 }
 
 // One RRT step from the real nodes: a goal-biased sample, its nearest real node, a random
@@ -358,6 +395,9 @@ PlannerInfo lazysp_planner_info() {
                      "each one simulation"),
       goal_bias_parameter(),
       limit,
+      real_parameter("mark_weight", 2.0, 0, false,
+                     "rad of cost added per edge a scene other than the bundle's may block "
+                     "(workspace index), in the second search of a round"),
   };
   info.make = [](const ParameterValues& v) {
     return std::make_unique<BundlePlanner<LazySpSearch>>(v, "lazysp", false);
