@@ -54,6 +54,14 @@ WorldPtr default_world(const BundleHeader& h, const RobotModel& robot,
   return std::make_shared<const PlanningWorld>(robot, std::move(env), options, marker);
 }
 
+// The session's worlds: its default, and every later one, marked by one marker.
+SceneCache session_scenes(const BundleHeader& h, const RobotModel& robot,
+                          const SimulationOptions& options, const std::string& env_path,
+                          const WorkspaceIndexLoad& workspace) {
+  const EdgeMarker marker = session_marker(workspace, robot, h);
+  return SceneCache(robot, options, default_world(h, robot, options, env_path, marker), marker);
+}
+
 }  // namespace
 
 PlanningSession::PlanningSession(const std::string& bundle_path, bool memory_map,
@@ -63,10 +71,8 @@ PlanningSession::PlanningSession(const std::string& bundle_path, bool memory_map
       robot(load_bundle_robot(bundle.header(), robot_path)),
       settings(settings_from_header(bundle.header())),
       workspace(load_workspace_index(bundle, robot, memory_map)),
-      scenes(robot, unsampled(settings.simulation),
-             default_world(bundle.header(), robot, unsampled(settings.simulation), env_path,
-                           session_marker(workspace, robot, bundle.header())),
-             session_marker(workspace, robot, bundle.header())),
+      scenes(session_scenes(bundle.header(), robot, unsampled(settings.simulation), env_path,
+                            workspace)),
       indexes(load_bundle_indexes(bundle, memory_map)),
       index(indexes.starts),
       end_index(indexes.ends),

@@ -83,8 +83,7 @@ class LazySpSearch {
   bool prunable(double g, double h);
   bool within_limits(const JointVector& q) const;
   uint64_t cell(const JointVector& q) const;
-  // The bundle's P_collision (its build scene's), and in the second search of a round the
-  // scene's marks too.
+  // The bundle's P_collision (its build scene's), and in a marked search the scene's marks.
   double risk(uint32_t e) const {
     const double stored = bundle_.has_perturbation() ? bundle_.p_collision(e) : 0.0;
     const bool marked = use_marks_ && ctx_.scene_marks->may_collide(e);
@@ -157,11 +156,11 @@ bool LazySpSearch::lazy_turn() {
   return lazy_work_ <= kHeadStart + share * growth_work_;
 }
 
-// In a scene other than the bundle's, a candidate that crosses edges the scene may block
-// (workspace-index marks) gets a second opinion: the same search with the marks in the edge cost,
-// given as many expansions again as the first took; its candidate is simulated instead when it
-// crosses fewer marked edges. Costing the marks in every search would let a goal surrounded by
-// marked edges (a shelf's compartment) cost the search a hundred times more expansions.
+// In a scene other than the bundle's, a round first looks for a candidate with the edges the scene
+// may block (workspace-index marks) costed, within kMarkedSearchLimit expansions, then as in the
+// bundle's scene. A goal enclosed by marked edges (a shelf's compartment) would let the marked
+// search cost a hundred times more expansions: after one marked search finds nothing, the solve
+// skips them.
 void LazySpSearch::lazy_round() {
   const uint64_t rollouts = s_.result().counters.simulations;
   size_t expansions = 0;
@@ -397,7 +396,7 @@ PlannerInfo lazysp_planner_info() {
       limit,
       real_parameter("mark_weight", 2.0, 0, false,
                      "rad of cost added per edge a scene other than the bundle's may block "
-                     "(workspace index), in the second search of a round"),
+                     "(workspace index), in the first search of each round"),
   };
   info.make = [](const ParameterValues& v) {
     return std::make_unique<BundlePlanner<LazySpSearch>>(v, "lazysp", false);
