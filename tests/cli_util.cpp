@@ -1,8 +1,15 @@
 #include "cli_util.h"
 
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
 #include <filesystem>
 #include <fstream>
+#include <thread>
 
 namespace lazyboe::test {
 
@@ -149,5 +156,46 @@ void expect_same_perturbation_arrays(const Perturbation& a, const Perturbation& 
       return ::testing::AssertionFailure() << "bytes differ from " << first << " to " << last;
   return ::testing::AssertionSuccess();
 }
+
+Background spawn_tool(const std::string& tool_name, const std::vector<std::string>& args,
+                      const std::string& log_prefix) {
+  Background b;
+  b.out_path = log_prefix + ".stdout";
+  b.err_path = log_prefix + ".stderr";
+  const std::string tool = tool_path(tool_name);
+  std::vector<std::string> all = {tool};
+  all.insert(all.end(), args.begin(), args.end());
+  std::vector<char*> argv;
+  for (std::string& a : all) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
+  posix_spawn_file_actions_addopen(&actions, 1, b.out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC,
+                                   0644);
+  posix_spawn_file_actions_addopen(&actions, 2, b.err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC,
+                                   0644);
+  b.started = std::chrono::steady_clock::now();
+  const int rc = posix_spawn(&b.pid, tool.c_str(), &actions, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  if (rc != 0) {
+    ADD_FAILURE() << "posix_spawn " << tool << ": " << std::strerror(rc);
+    b.pid = -1;
+  }
+  return b;
+}
+
+int wait_for(Background& b) {
+  if (b.pid < 0) return -1000;
+  int status = 0;
+  while (::waitpid(b.pid, &status, 0) < 0 && errno == EINTR) {
+  }
+  b.pid = -1;
+  if (WIFEXITED(status)) return WEXITSTATUS(status);
+  if (WIFSIGNALED(status)) return -WTERMSIG(status);
+  return -1000;
+}
+
+void sleep_seconds(double s) { std::this_thread::sleep_for(std::chrono::duration<double>(s)); }
 
 }  // namespace lazyboe::test

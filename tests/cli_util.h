@@ -3,7 +3,9 @@
 #pragma once
 
 #include <gtest/gtest.h>
+#include <sys/types.h>
 
+#include <chrono>
 #include <cstring>
 #include <map>
 #include <sstream>
@@ -49,6 +51,20 @@ std::map<std::string, std::string> snapshot(const std::string& dir);
 void write_bytes(const std::string& path, const std::string& bytes);
 
 std::string garbage_bytes();
+
+// A tool running in the background (for signals), its stdin from /dev/null, stdout and stderr to
+// files.
+struct Background {
+  pid_t pid = -1;
+  std::string out_path, err_path;  // <log_prefix>.stdout, .stderr
+  std::chrono::steady_clock::time_point started;
+};
+// Starts build/bin/<tool> with `args`; a failure to start fails the test (pid -1).
+Background spawn_tool(const std::string& tool, const std::vector<std::string>& args,
+                      const std::string& log_prefix);
+// Waits for the process; the exit status, or -signal when it was killed by a signal.
+int wait_for(Background& b);
+void sleep_seconds(double s);
 
 // Bit-for-bit equality of two arrays, reporting the first difference.
 template <typename T>

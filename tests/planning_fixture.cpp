@@ -153,6 +153,13 @@ JointVector PlanningFixture::edge_start(size_t e) const {
   return joint(std::vector<double>(&data.q0[e * n], &data.q0[e * n] + n));
 }
 
+std::vector<std::string> own_planners() {
+  std::vector<std::string> names;
+  for (const PlannerInfo& info : planner_registry())
+    if (!info.needs.ompl) names.push_back(info.name);
+  return names;
+}
+
 bool is_bundle_planner(const std::string& planner) {
   const PlannerInfo* info = find_planner(planner);
   return info && info->needs.bundle;

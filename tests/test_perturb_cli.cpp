@@ -16,7 +16,6 @@
 #include <gtest/gtest.h>
 #include <hdf5.h>
 #include <signal.h>
-#include <spawn.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -46,7 +45,6 @@
 #include "lazyboe/bundle/perturbation.h"
 #include "test_util.h"
 
-extern char** environ;
 
 namespace lazyboe::test {
 namespace {
@@ -85,52 +83,9 @@ std::string env_file(const std::string& name) { return source_path("data/environ
 
 // ---- A run in the background, for signals -------------------------------------------------
 
-struct Background {
-  pid_t pid = -1;
-  std::string out_path, err_path;
-  Clock::time_point started;
-};
-
 Background spawn_perturb(const std::vector<std::string>& args, const std::string& log_prefix) {
-  Background b;
-  b.out_path = log_prefix + ".stdout";
-  b.err_path = log_prefix + ".stderr";
-  const std::string tool = tool_path("lazyboe-perturb");
-  std::vector<std::string> all = {tool};
-  all.insert(all.end(), args.begin(), args.end());
-  std::vector<char*> argv;
-  for (std::string& a : all) argv.push_back(a.data());
-  argv.push_back(nullptr);
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
-  posix_spawn_file_actions_addopen(&actions, 1, b.out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC,
-                                   0644);
-  posix_spawn_file_actions_addopen(&actions, 2, b.err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC,
-                                   0644);
-  b.started = Clock::now();
-  const int rc = posix_spawn(&b.pid, tool.c_str(), &actions, nullptr, argv.data(), environ);
-  posix_spawn_file_actions_destroy(&actions);
-  if (rc != 0) {
-    ADD_FAILURE() << "posix_spawn " << tool << ": " << std::strerror(rc);
-    b.pid = -1;
-  }
-  return b;
+  return spawn_tool("lazyboe-perturb", args, log_prefix);
 }
-
-// Waits for the process; the exit status, or -signal when it was killed by a signal.
-int wait_for(Background& b) {
-  if (b.pid < 0) return -1000;
-  int status = 0;
-  while (::waitpid(b.pid, &status, 0) < 0 && errno == EINTR) {
-  }
-  b.pid = -1;
-  if (WIFEXITED(status)) return WEXITSTATUS(status);
-  if (WIFSIGNALED(status)) return -WTERMSIG(status);
-  return -1000;
-}
-
-void sleep_seconds(double s) { std::this_thread::sleep_for(std::chrono::duration<double>(s)); }
 
 // The file's identity: a checkpoint renames a new file over it, which changes the inode.
 ino_t inode_of(const std::string& path) {

@@ -14,6 +14,7 @@
 #include "lazyboe/common/atomic_file.h"
 #include "lazyboe/common/file_checks.h"
 #include "lazyboe/common/histogram.h"
+#include "lazyboe/common/process_memory.h"
 #include "lazyboe/io/query_io.h"
 #include "lazyboe/planning/planning_session.h"
 #include "lazyboe/planning/registry.h"

@@ -1,7 +1,6 @@
 #include "lazyboe/planning/planning_session.h"
 
 #include <chrono>
-#include <fstream>
 
 namespace lazyboe {
 namespace {
@@ -117,21 +116,6 @@ PlanningContext PlanningSession::context(const PlanningWorld& w) const {
   PlanningContext c = bundle_context(w.sim, bundle, index, &end_index, mean_displacement);
   c.scene_marks = w.edge_marks.get();
   return c;
-}
-
-double resident_memory_mib() {
-  std::ifstream status("/proc/self/status");
-  std::string key;
-  while (status >> key) {
-    if (key == "VmRSS:") {
-      double kib = 0;
-      status >> kib;
-      return kib / 1024;
-    }
-    std::string rest;
-    std::getline(status, rest);
-  }
-  return 0;
 }
 
 }  // namespace lazyboe

@@ -77,7 +77,4 @@ class PlanningSession {
   double default_theta() const { return bundle_theta(bundle); }
 };
 
-// Resident memory of this process (VmRSS), MiB; 0 where /proc is not available.
-double resident_memory_mib();
-
 }  // namespace lazyboe

@@ -10,9 +10,7 @@ PlannerInfo boe_planner_info() {
   info.description = "Bundle of Edges: best-first search simulating every edge within theta";
   info.needs.bundle = true;
   info.parameters = {theta_parameter()};
-  info.make = [](const ParameterValues& v) {
-    return std::make_unique<BundlePlanner<BundleSearch>>(v, "boe", false);
-  };
+  info.make = bundle_planner_factory<BundleSearch>(info);
   return info;
 }
 

@@ -13,6 +13,7 @@
 
 #include "lazyboe/common/error.h"
 #include "lazyboe/planning/parameters.h"
+#include "lazyboe/planning/registry.h"
 #include "lazyboe/planning/rollout_scheduler.h"
 #include "lazyboe/planning/search_tree.h"
 
@@ -134,5 +135,14 @@ class BundlePlanner : public Planner {
   const PlanningContext* context_ = nullptr;
   double theta_ = 0;
 };
+
+// The factory of a planner over `Search`, with its name and needs as `info` declares them (set
+// them before this, so that each is written once).
+template <typename Search>
+decltype(PlannerInfo::make) bundle_planner_factory(const PlannerInfo& info) {
+  return [name = info.name, perturbation = info.needs.perturbation](const ParameterValues& v) {
+    return std::make_unique<BundlePlanner<Search>>(v, name, perturbation);
+  };
+}
 
 }  // namespace lazyboe

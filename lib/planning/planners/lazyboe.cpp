@@ -181,9 +181,7 @@ PlannerInfo lazyboe_planner_info() {
       "displacement, with P_lazy_prop under transfer";
   info.parameters = {theta_parameter(), model};
   info.study_variants = {{"lazyboe", {}}, {"lazyboe-transfer", {{"lazy_model", kTransferIndex}}}};
-  info.make = [](const ParameterValues& v) {
-    return std::make_unique<BundlePlanner<LazySearch>>(v, "lazyboe", true);
-  };
+  info.make = bundle_planner_factory<LazySearch>(info);
   return info;
 }
 

@@ -30,10 +30,10 @@ constexpr double kFailuresPerShare = 20;
 // marks in the edge cost, before the round searches without them.
 constexpr size_t kMarkedSearchLimit = 1000;
 
+// The declared parameters' values (lazysp_planner_info has their defaults).
 struct Settings {
-  double theta = 0, epsilon = 2, resolution = 0.05, risk_weight = 0.5, edge_penalty = 0.3,
-         goal_bias = 0.05, mark_weight = 2;
-  size_t expansion_limit = 20000;
+  double theta, epsilon, resolution, risk_weight, edge_penalty, goal_bias, mark_weight;
+  size_t expansion_limit;
 };
 
 // A state of the lazy search: predicted (never simulated) or, for a source, a real node's.
@@ -398,9 +398,7 @@ PlannerInfo lazysp_planner_info() {
                      "rad of cost added per edge a scene other than the bundle's may block "
                      "(workspace index), in the first search of each round"),
   };
-  info.make = [](const ParameterValues& v) {
-    return std::make_unique<BundlePlanner<LazySpSearch>>(v, "lazysp", false);
-  };
+  info.make = bundle_planner_factory<LazySpSearch>(info);
   return info;
 }
 

@@ -9,9 +9,7 @@ PlannerInfo rrt_planner_info() {
   info.name = "rrt";
   info.description = "kinodynamic RRT with goal bias; stops at its first solution";
   info.parameters = {goal_bias_parameter()};
-  info.make = [](const ParameterValues& v) {
-    return std::make_unique<TreePlanner<TreeSearch>>(v, "rrt");
-  };
+  info.make = tree_planner_factory<TreeSearch>(info);
   return info;
 }
 

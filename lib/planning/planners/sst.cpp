@@ -97,9 +97,7 @@ PlannerInfo sst_planner_info() {
     const std::string suffix = ratio == 0.5 ? "0.5x" : ratio == 1.0 ? "1x" : "2x";
     info.study_variants.push_back({"sst-" + suffix, {{"pruning_ratio", ratio}}});
   }
-  info.make = [](const ParameterValues& v) {
-    return std::make_unique<TreePlanner<SstSearch>>(v, "sst");
-  };
+  info.make = tree_planner_factory<SstSearch>(info);
   return info;
 }
 

@@ -74,9 +74,7 @@ void sample_state(const PlanningContext& ctx, const PlanningProblem& p, double g
   for (int i = 0; i < x.size(); ++i) x[i] = rng.uniform(ctx.sample_lower[i], ctx.sample_upper[i]);
 }
 
-void TreeSearch::sample(JointVector& x) {
-  sample_state(ctx_, s_.problem(), goal_bias_, rng_, x);
-}
+void TreeSearch::sample(JointVector& x) { sample_state(ctx_, s_.problem(), goal_bias_, rng_, x); }
 
 int TreeSearch::nearest(const JointVector& x) { return nearest_live(s_.nodes(), x); }
 

@@ -10,6 +10,7 @@
 
 #include "lazyboe/common/error.h"
 #include "lazyboe/planning/parameters.h"
+#include "lazyboe/planning/registry.h"
 #include "lazyboe/planning/search_tree.h"
 #include "lazyboe/sim/random.h"
 
@@ -79,6 +80,14 @@ class TreePlanner : public Planner {
   std::string name_;
   const PlanningContext* context_ = nullptr;
 };
+
+// The factory of a planner over `Search`, named as `info` declares it (set the name first).
+template <typename Search>
+decltype(PlannerInfo::make) tree_planner_factory(const PlannerInfo& info) {
+  return [name = info.name](const ParameterValues& v) {
+    return std::make_unique<TreePlanner<Search>>(v, name);
+  };
+}
 
 // A goal-biased sample: a joint goal with probability goal_bias, else uniform in the context's
 // sampling box.
