@@ -1,5 +1,8 @@
 // Bookkeeping every search of ours shares: the tree's nodes, the solutions found, the
-// counters, the clock. Internal to the planners (not installed).
+// counters, the clock. Each search has its own node type (OMPL's Motion) derived from
+// SearchNode: BundleNode (BoE, LazyBoE), TreeNode (RRT, SST), lazysp's LazySpNode; what only one
+// planner needs (LazyBoE's lazy and failed nodes, SST's witnesses and pruning) it keeps itself.
+// Internal to the planners (not installed).
 #pragma once
 
 #include <cstdint>
@@ -10,20 +13,15 @@
 
 namespace lazyboe {
 
+// What every search's node has.
 struct SearchNode {
-  JointVector q;  // state at rest; for a lazy node, the stored end of its edge
+  JointVector q;  // state at rest; for a LazyBoE lazy node, where its edge is taken to end
   int parent = -1;
-  int64_t bundle_edge = -1;  // bundle planners: the edge from the parent
-  int command = -1;          // sampling planners: index into the search's own commands
-  double cost = 0;           // arc length from the start (estimated for lazy nodes)
-  double h = 0;              // heuristic: distance to the goal
-  bool lazy = false;         // LazyBoE: taken without simulation
-  bool failed = false;       // LazyBoE: its simulation failed, so its lazy subtree is dead
-  bool pruned = false;       // SST: removed from the tree
-  bool inactive = false;     // SST: no longer the representative of its witness
-  bool expanded = false;
+  double cost = 0;  // arc length from the start (estimated for lazy nodes)
+  double h = 0;     // heuristic: distance to the goal
 };
 
+template <typename Node>
 class SearchState {
  public:
   SearchState(const PlanningContext& ctx, SimulatorWorkspace& ws, const PlanningProblem& p)
@@ -35,8 +33,8 @@ class SearchState {
 
   const PlanningContext& context() const { return ctx_; }
   const PlanningProblem& problem() const { return problem_; }
-  std::vector<SearchNode>& nodes() { return nodes_; }
-  SearchNode& node(int v) { return nodes_[v]; }
+  std::vector<Node>& nodes() { return nodes_; }
+  Node& node(int v) { return nodes_[v]; }
   PlanResult& result() { return result_; }
 
   double heuristic(const JointVectorRef& q) {
@@ -44,7 +42,7 @@ class SearchState {
   }
   bool in_goal(double h) const { return h <= problem_.goal.tolerance; }
 
-  int add(SearchNode n) {
+  int add(Node n) {
     nodes_.push_back(std::move(n));
     ++result_.counters.nodes;
     return static_cast<int>(nodes_.size()) - 1;
@@ -86,7 +84,7 @@ class SearchState {
   const PlanningProblem& problem_;
   Deadline deadline_;
   RobotData goal_data_;
-  std::vector<SearchNode> nodes_;
+  std::vector<Node> nodes_;
   PlanResult result_;
 };
 

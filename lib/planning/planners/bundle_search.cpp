@@ -59,7 +59,7 @@ double BundleSearch::heuristic_at_end(uint32_t e) {
 }
 
 PlanResult BundleSearch::run() {
-  SearchNode root;
+  BundleNode root;
   root.q = s_.problem().start;
   root.h = s_.heuristic(root.q);
   push(s_.add(root));
@@ -108,9 +108,8 @@ int BundleSearch::pop() {
 }
 
 bool BundleSearch::skip(int v) {
-  const SearchNode& node = s_.node(v);
-  if (node.expanded || dead(v)) return true;
-  if (s_.in_goal(node.h) && !node.lazy) return true;  // already a solution
+  if (s_.node(v).expanded || dead(v)) return true;
+  if (is_solution(v)) return true;  // already one
   return prunable(v);
 }
 
@@ -135,20 +134,12 @@ void BundleSearch::order_by_promise(int v, Neighbours& edges) {
                    [](const auto& x, const auto& y) { return x.second < y.second; });
 }
 
-bool BundleSearch::dead(int v) {
-  for (int u = v; u >= 0; u = s_.node(u).parent) {
-    if (s_.node(u).failed) return true;
-    if (!s_.node(u).lazy) break;
-  }
-  return false;
-}
-
 // After a solution, a node whose cost plus the least remaining arc length (joint goals:
 // distance to the goal minus the tolerance) cannot beat the best is not expanded.
 bool BundleSearch::prunable(int v) {
   const PlanResult& r = s_.result();
   if (!r.success || s_.problem().goal.kind != Goal::Kind::Joint) return false;
-  const SearchNode& node = s_.node(v);
+  const BundleNode& node = s_.node(v);
   return node.cost + std::max(0.0, node.h - s_.problem().goal.tolerance) >= r.best_cost;
 }
 
@@ -187,7 +178,7 @@ void BundleSearch::simulate_edge(int v, uint32_t e, size_t k) {
   if (!simulated_.insert(key(v, e)).second) return;
   const RolloutResult r = rollout_from(v, k);
   if (!r.valid()) return;
-  SearchNode c;
+  BundleNode c;
   c.q = r.qf;
   c.parent = v;
   c.bundle_edge = e;

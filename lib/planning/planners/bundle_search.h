@@ -19,6 +19,12 @@
 
 namespace lazyboe {
 
+// A node of the bundle searches: a state reached by a bundle edge.
+struct BundleNode : SearchNode {
+  int64_t bundle_edge = -1;  // the edge from the parent (-1: the root)
+  bool expanded = false;
+};
+
 class BundleSearch {
  public:
   BundleSearch(const PlanningContext& ctx, SimulatorWorkspace& ws, const PlanningProblem& p,
@@ -52,11 +58,13 @@ class BundleSearch {
   virtual double promise(int /*v*/, uint32_t e) { return heuristic_at_end(e); }
   // Whether neighbour k of the real node v needs a rollout from v in this expansion.
   virtual bool needs_rollout(int v, size_t k);
+  // Whether node v can no longer be part of a path (LazyBoE: under a failed lazy edge).
+  virtual bool dead(int /*v*/) { return false; }
+  // Whether node v is a solution (LazyBoE: not while its edge is only taken lazily).
+  virtual bool is_solution(int v) { return s_.in_goal(s_.node(v).h); }
 
   // ---- For the hooks ----
   void push(int node) { open_.emplace(s_.node(node).h, node); }
-  // A node under a failed lazy ancestor is dead too.
-  bool dead(int v);
   bool simulated(int v, uint32_t e) const { return simulated_.count(key(v, e)) > 0; }
   // Simulates edge e from the real node v (k: its place in the expansion) and adds the child.
   void simulate_edge(int v, uint32_t e, size_t k);
@@ -72,7 +80,7 @@ class BundleSearch {
 
   const PlanningContext& ctx_;
   const BundleView& bundle_;
-  SearchState s_;
+  SearchState<BundleNode> s_;
   const double theta_;
 
  private:

@@ -34,21 +34,22 @@ class LazySearch : public BundleSearch {
     if (exhaustive_) return false;
     exhaustive_ = true;
     for (size_t u = 0; u < s_.nodes().size(); ++u) {
-      SearchNode& node = s_.nodes()[u];
-      if (node.lazy || node.failed || s_.in_goal(node.h)) continue;
+      BundleNode& node = s_.nodes()[u];
+      const int v = static_cast<int>(u);
+      if (lazy(v) || failed(v) || s_.in_goal(node.h)) continue;
       node.expanded = false;
-      push(static_cast<int>(u));
+      push(v);
     }
     return true;
   }
 
-  double radius(int v) override { return s_.node(v).lazy ? theta_ / 2 : theta_; }
+  double radius(int v) override { return lazy(v) ? theta_ / 2 : theta_; }
 
   // The lazy chain cannot go on (nothing starts within theta/2 of its stored end): it
   // terminates and is simulated; the node goes back to the queue as a real one, keyed by its
   // simulated heuristic (realize), and competes with the rest before its expansion.
   bool defer(int v) override {
-    if (!s_.node(v).lazy) return false;
+    if (!lazy(v)) return false;
     realize(v);
     return true;
   }
@@ -71,7 +72,7 @@ class LazySearch : public BundleSearch {
         take_lazily(v, e, k);
         return true;
       }
-      if (s_.node(v).lazy && !realize(v)) return false;  // simulate the chain up to v first
+      if (lazy(v) && !realize(v)) return false;  // simulate the chain up to v first
     }
     simulate_edge(v, e, k);
     return true;
@@ -100,23 +101,42 @@ class LazySearch : public BundleSearch {
   void take_lazily(int v, uint32_t e, size_t k);
   bool realize(int x, long k = -1);
 
+  // LazyBoE's own node data, by node id (nodes the shared search adds are real: absent here).
+  bool lazy(int v) const { return static_cast<size_t>(v) < lazy_.size() && lazy_[v]; }
+  bool failed(int v) const { return static_cast<size_t>(v) < failed_.size() && failed_[v]; }
+  static void set(std::vector<char>& flags, int v, bool value) {
+    if (flags.size() <= static_cast<size_t>(v)) flags.resize(static_cast<size_t>(v) + 1, 0);
+    flags[v] = value;
+  }
+  // A node under a failed lazy ancestor is dead too.
+  bool dead(int v) override {
+    for (int u = v; u >= 0; u = s_.node(u).parent) {
+      if (failed(u)) return true;
+      if (!lazy(u)) break;
+    }
+    return false;
+  }
+  bool is_solution(int v) override { return s_.in_goal(s_.node(v).h) && !lazy(v); }
+
   const bool transfer_;
   Random rng_;
   bool exhaustive_ = false;
   bool lazy_search_ = false;
   std::vector<char> take_lazy_;
+  std::vector<char> lazy_;    // taken without simulation (its state: where it is taken to end)
+  std::vector<char> failed_;  // its simulation failed, so its lazy subtree is dead
 };
 
 void LazySearch::take_lazily(int v, uint32_t e, size_t k) {
   ++s_.result().counters.lazy_edges;
-  SearchNode c;
+  BundleNode c;
   c.q = lazy_end(v, e);
   c.parent = v;
   c.bundle_edge = e;
-  c.lazy = true;
   c.cost = s_.node(v).cost + (edge_end(e) - edge_start(e)).norm();
   c.h = s_.heuristic(c.q);
   const int id = s_.add(c);
+  set(lazy_, id, true);
   // SHOULD_TERMINATE_LAZY: the lazy path reaches the goal region (simulate it, the child
   // included), or the heuristic rises again (simulate the chain up to the parent, which was
   // the best point of it; the child waits in the queue). A tie counts as rising: an edge
@@ -124,7 +144,7 @@ void LazySearch::take_lazily(int v, uint32_t e, size_t k) {
   // and a chain without progress would otherwise grow forever for free.
   if (s_.in_goal(c.h)) {
     realize(id, static_cast<long>(k));
-  } else if (c.h >= s_.node(v).h && s_.node(v).lazy) {
+  } else if (c.h >= s_.node(v).h && lazy(v)) {
     if (realize(v)) push(id);
   } else {
     push(id);
@@ -136,7 +156,7 @@ void LazySearch::take_lazily(int v, uint32_t e, size_t k) {
 // `k`: x is the lazy child of the expanded node for its neighbour k (a one-edge chain).
 bool LazySearch::realize(int x, long k) {
   std::vector<int> chain;
-  for (int u = x; s_.node(u).lazy; u = s_.node(u).parent) chain.push_back(u);
+  for (int u = x; lazy(u); u = s_.node(u).parent) chain.push_back(u);
   std::reverse(chain.begin(), chain.end());
   for (int u : chain) {
     const int parent = s_.node(u).parent;
@@ -145,12 +165,12 @@ bool LazySearch::realize(int x, long k) {
             ? rollout_from(parent, static_cast<size_t>(k))
             : s_.simulate_from(s_.node(parent).q, bundle_.command(s_.node(u).bundle_edge));
     if (!r.valid()) {
-      s_.node(u).failed = true;
+      set(failed_, u, true);
       return false;
     }
-    SearchNode& n = s_.node(u);
+    BundleNode& n = s_.node(u);
     n.q = r.qf;
-    n.lazy = false;
+    set(lazy_, u, false);
     n.cost = s_.node(parent).cost + r.path_length;
     n.h = s_.heuristic(n.q);
     if (s_.in_goal(n.h)) {

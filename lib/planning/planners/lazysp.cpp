@@ -49,6 +49,12 @@ struct Predicted {
 
 using Neighbours = std::vector<std::pair<uint32_t, double>>;
 
+// A real (simulated) state of lazysp's tree, reached by a bundle edge or a growth command.
+struct LazySpNode : SearchNode {
+  int64_t bundle_edge = -1;  // the bundle edge from the parent, or -1
+  int command = -1;          // else the growth's command (index into commands_), or -1: the root
+};
+
 class LazySpSearch {
  public:
   // The constructor BundlePlanner calls (the pool is not used: one thread).
@@ -103,14 +109,14 @@ class LazySpSearch {
 
   const PlanningContext& ctx_;
   const BundleView& bundle_;
-  SearchState s_;
+  SearchState<LazySpNode> s_;
   const Settings set_;
   // The heuristic counts the edge penalty too: h / mean displacement more edges to the goal.
   const double h_scale_;
   Random rng_;
   bool goal_covered_ = true;
   std::unordered_set<uint64_t> tried_;  // (real node, edge) pairs simulated, valid or not
-  std::vector<PathStep> commands_;      // the growth's commands, by SearchNode::command
+  std::vector<PathStep> commands_;      // the growth's commands, by LazySpNode::command
   Neighbours neighbours_;
   // One round of the lazy search (rebuilt every round from the real nodes).
   std::vector<Predicted> preds_;
@@ -196,9 +202,9 @@ int LazySpSearch::search(size_t& expansions, size_t limit) {
   preds_.clear();
   open_ = {};
   best_in_cell_.clear();
-  const std::vector<SearchNode>& nodes = s_.nodes();
+  const std::vector<LazySpNode>& nodes = s_.nodes();
   for (size_t v = 0; v < nodes.size(); ++v) {
-    const SearchNode& n = nodes[v];
+    const LazySpNode& n = nodes[v];
     if (s_.in_goal(n.h) || prunable(n.cost, n.h)) continue;  // a solution, or no better one
     Predicted x;
     x.q = n.q;
@@ -293,7 +299,7 @@ void LazySpSearch::grow() {
   const int n = ctx_.sim.robot.dof;
   JointVector x(n);
   sample_state(ctx_, s_.problem(), set_.goal_bias, rng_, x);
-  const int from = nearest_live(s_.nodes(), x);
+  const int from = nearest_node(s_.nodes(), x, [](int) { return true; });
   std::vector<double> knots;
   const double duration = sample_command_profile(ctx_.sim.robot, ctx_.command, rng_, knots);
   const CommandProfile profile{knots.data(), static_cast<int>(knots.size() / n), n, duration};
@@ -308,7 +314,7 @@ void LazySpSearch::grow() {
 
 int LazySpSearch::add_real(const JointVector& q, int parent, int64_t edge, int command,
                            double cost) {
-  SearchNode n;
+  LazySpNode n;
   n.q = q;
   n.parent = parent;
   n.bundle_edge = edge;
@@ -327,7 +333,7 @@ void LazySpSearch::found(int node, const char* by) {
 std::vector<PathStep> LazySpSearch::path_to(int node) {
   std::vector<PathStep> steps;
   for (int u = node; s_.node(u).parent >= 0; u = s_.node(u).parent) {
-    const SearchNode& n = s_.node(u);
+    const LazySpNode& n = s_.node(u);
     if (n.bundle_edge < 0) {
       steps.push_back(commands_[n.command]);
       continue;

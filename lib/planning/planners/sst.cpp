@@ -21,15 +21,15 @@ class SstSearch : public TreeSearch {
     int representative;
   };
 
-  void start(const SearchNode& root) override { witnesses_.push_back({root.q, 0}); }
+  void start(const TreeNode& root) override { witnesses_.push_back({root.q, 0}); }
 
   // Best-Near: the lowest-cost active node within delta_BN, else the nearest.
   int select(const JointVector& x) override {
     int best = -1;
     double best_cost = std::numeric_limits<double>::infinity();
-    const std::vector<SearchNode>& nodes = s_.nodes();
+    const std::vector<TreeNode>& nodes = s_.nodes();
     for (size_t v = 0; v < nodes.size(); ++v) {
-      if (nodes[v].pruned || nodes[v].inactive) continue;
+      if (!live(static_cast<int>(v))) continue;
       if ((nodes[v].q - x).norm() <= delta_bn_ && nodes[v].cost < best_cost) {
         best_cost = nodes[v].cost;
         best = static_cast<int>(v);
@@ -40,7 +40,7 @@ class SstSearch : public TreeSearch {
 
   // A node joins when it is the first or the cheapest near its witness (a new witness when
   // none is within delta_s); the representative it replaces becomes inactive.
-  bool admit(const SearchNode& c) override {
+  bool admit(const TreeNode& c) override {
     witness_ = nearest_witness(c.q);
     if (witness_ < 0 || (witnesses_[witness_].q - c.q).norm() > delta_s_) {
       witnesses_.push_back({c.q, -1});
@@ -49,10 +49,23 @@ class SstSearch : public TreeSearch {
     const int rep = witnesses_[witness_].representative;
     if (rep >= 0 && s_.node(rep).cost <= c.cost) return false;  // not better locally: drop
     if (rep >= 0) {
-      s_.node(rep).inactive = true;
+      retire(rep);  // inactive: no longer its witness's representative
       prune_upwards(rep);
     }
     return true;
+  }
+
+  // The node and its now childless ancestors, upwards, are removed from the tree while
+  // inactive.
+  void prune_upwards(int v) {
+    std::vector<int>& children = this->children();
+    pruned_.resize(s_.nodes().size(), 0);
+    while (v > 0 && !live(v) && !pruned_[v] && children[v] == 0) {
+      pruned_[v] = 1;
+      const int parent = s_.node(v).parent;
+      --children[parent];
+      v = parent;
+    }
   }
 
   void added(int id) override { witnesses_[witness_].representative = id; }
@@ -73,7 +86,8 @@ class SstSearch : public TreeSearch {
 
   const double delta_bn_, delta_s_;
   std::vector<Witness> witnesses_;
-  int witness_ = -1;  // of the node being admitted
+  int witness_ = -1;          // of the node being admitted
+  std::vector<char> pruned_;  // removed from the tree (retired, and no children left)
 };
 
 }  // namespace

@@ -28,11 +28,10 @@ TreeSearch::TreeSearch(const PlanningContext& ctx, SimulatorWorkspace& ws, const
 
 PlanResult TreeSearch::run() {
   const int n = ctx_.sim.robot.dof;
-  SearchNode root;
+  TreeNode root;
   root.q = s_.problem().start;
   root.h = s_.heuristic(root.q);
-  s_.add(root);
-  children_.push_back(0);
+  add(root, -1);
   start(root);
   JointVector x(n);
   std::vector<double> knots;
@@ -43,7 +42,7 @@ PlanResult TreeSearch::run() {
     const CommandProfile profile{knots.data(), static_cast<int>(knots.size() / n), n, duration};
     const RolloutResult r = s_.simulate_from(s_.node(from).q, profile);
     if (!r.valid()) continue;
-    SearchNode c;
+    TreeNode c;
     c.q = r.qf;
     c.parent = from;
     c.cost = s_.node(from).cost + r.path_length;
@@ -51,9 +50,7 @@ PlanResult TreeSearch::run() {
     if (!admit(c)) continue;
     c.command = static_cast<int>(commands_.size());
     commands_.push_back({-1, knots, duration});
-    const int id = s_.add(c);
-    children_.push_back(0);
-    ++children_[from];
+    const int id = add(c, from);
     added(id);
     if (s_.in_goal(c.h)) {
       s_.solution(id, [this](int u) { return path_to(u); });
@@ -76,30 +73,16 @@ void sample_state(const PlanningContext& ctx, const PlanningProblem& p, double g
 
 void TreeSearch::sample(JointVector& x) { sample_state(ctx_, s_.problem(), goal_bias_, rng_, x); }
 
-int TreeSearch::nearest(const JointVector& x) { return nearest_live(s_.nodes(), x); }
-
-int nearest_live(const std::vector<SearchNode>& nodes, const JointVector& x) {
-  int best = 0;
-  double best_d = std::numeric_limits<double>::infinity();
-  for (size_t v = 0; v < nodes.size(); ++v) {
-    if (nodes[v].pruned || nodes[v].inactive) continue;
-    const double d = (nodes[v].q - x).squaredNorm();
-    if (d < best_d) {
-      best_d = d;
-      best = static_cast<int>(v);
-    }
-  }
-  return best;
+int TreeSearch::nearest(const JointVector& x) {
+  return nearest_node(s_.nodes(), x, [this](int v) { return live(v); });
 }
 
-void TreeSearch::prune_upwards(int v) {
-  std::vector<SearchNode>& nodes = s_.nodes();
-  while (v > 0 && nodes[v].inactive && !nodes[v].pruned && children_[v] == 0) {
-    nodes[v].pruned = true;
-    const int parent = nodes[v].parent;
-    --children_[parent];
-    v = parent;
-  }
+int TreeSearch::add(TreeNode c, int from) {
+  const int id = s_.add(std::move(c));
+  children_.push_back(0);
+  retired_.push_back(0);
+  if (from >= 0) ++children_[from];
+  return id;
 }
 
 std::vector<PathStep> TreeSearch::path_to(int node) {

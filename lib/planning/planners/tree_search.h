@@ -4,6 +4,7 @@
 // state when the rollout is valid. SST (sst.cpp) overrides the hooks.
 #pragma once
 
+#include <limits>
 #include <string>
 #include <utility>
 #include <vector>
@@ -16,6 +17,28 @@
 
 namespace lazyboe {
 
+// A node of the tree searches: a state reached by one of the search's own commands.
+struct TreeNode : SearchNode {
+  int command = -1;  // index into the search's commands (-1: the root)
+};
+
+// The node of `nodes` nearest to x (squared Euclidean distance; the first of equals) among
+// those `live(v)` accepts; 0 when none does.
+template <typename Node, typename Live>
+int nearest_node(const std::vector<Node>& nodes, const JointVector& x, Live live) {
+  int best = 0;
+  double best_d = std::numeric_limits<double>::infinity();
+  for (size_t v = 0; v < nodes.size(); ++v) {
+    if (!live(static_cast<int>(v))) continue;
+    const double d = (nodes[v].q - x).squaredNorm();
+    if (d < best_d) {
+      best_d = d;
+      best = static_cast<int>(v);
+    }
+  }
+  return best;
+}
+
 class TreeSearch {
  public:
   TreeSearch(const PlanningContext& ctx, SimulatorWorkspace& ws, const PlanningProblem& p,
@@ -26,11 +49,11 @@ class TreeSearch {
 
  protected:
   // ---- Hooks (RRT's behaviour by default) ----
-  virtual void start(const SearchNode& /*root*/) {}
+  virtual void start(const TreeNode& /*root*/) {}
   // The tree node to extend towards the sample x.
   virtual int select(const JointVector& x) { return nearest(x); }
   // Whether the new node c (not yet added) joins the tree.
-  virtual bool admit(const SearchNode& /*c*/) { return true; }
+  virtual bool admit(const TreeNode& /*c*/) { return true; }
   // Called once the admitted node is in the tree as `id`.
   virtual void added(int /*id*/) {}
   // RRT stops at its first solution.
@@ -38,21 +61,25 @@ class TreeSearch {
 
   // The nearest live node.
   int nearest(const JointVector& x);
-  // The node and its now childless ancestors, upwards, are removed from the tree while
-  // inactive (SST's pruning).
-  void prune_upwards(int v);
+  // A node that selection no longer considers (SST: inactive or pruned).
+  void retire(int v) { retired_[v] = 1; }
+  bool live(int v) const { return !retired_[v]; }
+  // Children in the tree, per node (SST's pruning keeps it).
+  std::vector<int>& children() { return children_; }
 
   const PlanningContext& ctx_;
-  SearchState s_;
+  SearchState<TreeNode> s_;
   Random rng_;
 
  private:
   void sample(JointVector& x);
+  int add(TreeNode c, int from);
   std::vector<PathStep> path_to(int node);
 
   double goal_bias_;
   std::vector<PathStep> commands_;
   std::vector<int> children_;
+  std::vector<char> retired_;
 };
 
 // The context must have a sampling box of robot.dof joints.
@@ -93,9 +120,6 @@ decltype(PlannerInfo::make) tree_planner_factory(const PlannerInfo& info) {
 // sampling box.
 void sample_state(const PlanningContext& ctx, const PlanningProblem& problem, double goal_bias,
                   Random& rng, JointVector& x);
-
-// The node nearest to x (joint space) that is neither pruned nor inactive.
-int nearest_live(const std::vector<SearchNode>& nodes, const JointVector& x);
 
 // goal_bias, as RRT and SST (ours and OMPL's) declare it.
 ParameterSpec goal_bias_parameter();
