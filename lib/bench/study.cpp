@@ -2,6 +2,7 @@
 
 #include <omp.h>
 
+#include <algorithm>
 #include <optional>
 #include <sstream>
 
@@ -13,16 +14,42 @@ namespace lazyboe {
 
 namespace {
 
+// The index of `choice` among the choices of `planner`'s parameter `parameter`.
+double choice_index(const std::string& planner, const std::string& parameter,
+                    const std::string& choice) {
+  for (const ParameterSpec& p : find_planner(planner)->parameters) {
+    if (p.name != parameter) continue;
+    const auto at = std::find(p.choices.begin(), p.choices.end(), choice);
+    if (at != p.choices.end()) return static_cast<double>(at - p.choices.begin());
+  }
+  fail(planner, "has no " + parameter + " " + choice);
+}
+
+}  // namespace
+
+const std::vector<StudyVariant>& study_variants(const std::string& planner) {
+  static const std::vector<StudyVariant> none;
+  static const std::vector<StudyVariant> lazyboe = {
+      {"lazyboe", {}},
+      {"lazyboe-transfer", {{"lazy_model", choice_index("lazyboe", "lazy_model", "transfer")}}}};
+  static const std::vector<StudyVariant> sst = {{"sst-0.5x", {{"pruning_ratio", 0.5}}},
+                                                {"sst-1x", {{"pruning_ratio", 1.0}}},
+                                                {"sst-2x", {{"pruning_ratio", 2.0}}}};
+  return planner == "lazyboe" ? lazyboe : planner == "sst" ? sst : none;
+}
+
+namespace {
+
 // The names a study runs for a planner in "all": its variants, or itself.
 std::vector<std::string> study_names(const PlannerInfo& info) {
-  if (info.study_variants.empty()) return {info.name};
+  if (study_variants(info.name).empty()) return {info.name};
   std::vector<std::string> names;
-  for (const PlannerVariant& v : info.study_variants) names.push_back(v.name);
+  for (const StudyVariant& v : study_variants(info.name)) names.push_back(v.name);
   return names;
 }
 
 bool has_variant(const PlannerInfo& info, const std::string& name) {
-  for (const PlannerVariant& v : info.study_variants)
+  for (const StudyVariant& v : study_variants(info.name))
     if (v.name == name) return true;
   return false;
 }
@@ -38,7 +65,7 @@ std::string study_names_text() {
   std::vector<std::string> names = {"all"};
   for (const PlannerInfo& info : planner_registry()) {
     names.push_back(info.name);
-    for (const PlannerVariant& v : info.study_variants)
+    for (const StudyVariant& v : study_variants(info.name))
       if (v.name != info.name) names.push_back(v.name);
   }
   return list_text(names);
@@ -50,8 +77,8 @@ PlannerSpec spec_named(const std::string& name) {
     s.planner = info.name;
     s.available = info.available(&s.unavailable_reason);
     s.name = name;
-    if (info.study_variants.empty() && info.name == name) return s;
-    for (const PlannerVariant& v : info.study_variants) {
+    if (study_variants(info.name).empty() && info.name == name) return s;
+    for (const StudyVariant& v : study_variants(info.name)) {
       if (v.name != name) continue;
       s.parameters = v.values;
       return s;

@@ -14,6 +14,16 @@
 
 namespace lazyboe {
 
+// A named setting of a planner's parameters that studies run as a planner of its own: the
+// paper's SST pruning-to-selection ratios (sst-0.5x, sst-1x, sst-2x) and LazyBoE with each of its
+// lazy models (lazyboe, lazyboe-transfer). A study's concern, not the planner's.
+struct StudyVariant {
+  std::string name;
+  ParameterValues values;
+};
+// A planner's study variants; empty: studies run the planner itself.
+const std::vector<StudyVariant>& study_variants(const std::string& planner);
+
 struct PlannerSpec {
   std::string name;            // as in runs.csv: lazyboe, boe, rrt, sst-0.5x, ..., ompl-sst
   std::string planner;         // its name in the planner registry

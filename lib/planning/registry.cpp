@@ -159,11 +159,6 @@ std::string planner_list_text() {
       o << "  " << p.name << " (" << type_name(p.type) << ", " << p.range_text() << ", default "
         << p.default_text() << "): " << p.description << "\n";
     }
-    if (!info.study_variants.empty()) {
-      o << "  study variants:";
-      for (const PlannerVariant& v : info.study_variants) o << " " << v.name;
-      o << "\n";
-    }
   }
   return o.str();
 }

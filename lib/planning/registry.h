@@ -22,19 +22,11 @@ struct PlannerNeeds {
   bool ompl = false;          // a build with OMPL
 };
 
-// A named setting of a planner's parameters that studies run as a planner of its own (SST's
-// pruning-to-selection ratios of the paper: sst-0.5x, sst-1x, sst-2x).
-struct PlannerVariant {
-  std::string name;
-  ParameterValues values;
-};
-
 struct PlannerInfo {
   std::string name;
   std::string description;  // one line
   PlannerNeeds needs;
   std::vector<ParameterSpec> parameters;
-  std::vector<PlannerVariant> study_variants;  // empty: studies run the planner itself
   // Makes the planner from values for every parameter with a fixed default (make_planner
   // fills those in); parameters with a context default may be missing.
   std::function<std::unique_ptr<Planner>(const ParameterValues&)> make;

@@ -200,7 +200,6 @@ PlannerInfo lazyboe_planner_info() {
       "where a lazy edge ends: its stored end (the paper) or the node moved by the edge's "
       "displacement, with P_lazy_prop under transfer";
   info.parameters = {theta_parameter(), model};
-  info.study_variants = {{"lazyboe", {}}, {"lazyboe-transfer", {{"lazy_model", kTransferIndex}}}};
   info.make = bundle_planner_factory<LazySearch>(info);
   return info;
 }

@@ -16,7 +16,9 @@
 namespace lazyboe {
 namespace {
 
-constexpr uint64_t kStream = 2;  // LazyBoE draws from stream 0, RRT and SST from 1
+// Random streams of a query seed: LazyBoE 0, RRT and SST 1, lazysp 2, OMPL (its process-wide
+// seed) 4 and its planners 5.
+constexpr uint64_t kStream = 2;
 // Scheduling between the lazy part and the growth is counted in work, not time, so that a
 // seed gives the same result on any machine: one rollout is worth about this many expansions
 // (a k-d tree query and its successors; measured on the 100k table bundle, ~1 ms vs ~20 us).

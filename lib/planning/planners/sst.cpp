@@ -107,10 +107,6 @@ PlannerInfo sst_planner_info() {
   info.description = "Stable Sparse RRT: Best-Near selection and witness pruning; anytime";
   info.parameters = {goal_bias_parameter(), selection_radius_parameter(),
                      pruning_ratio_parameter()};
-  for (double ratio : {0.5, 1.0, 2.0}) {
-    const std::string suffix = ratio == 0.5 ? "0.5x" : ratio == 1.0 ? "1x" : "2x";
-    info.study_variants.push_back({"sst-" + suffix, {{"pruning_ratio", ratio}}});
-  }
   info.make = tree_planner_factory<SstSearch>(info);
   return info;
 }
