@@ -226,12 +226,46 @@ bool can_stop_dead(const RobotModel& robot, const RobotData& rd, const JointVect
   return within(rd.M * jump, 0.5 * robot.dtau_max * dt);
 }
 
+// Joint controller: gravity, friction and inertia feed-forward, P on the velocity error (rd:
+// this tick's dynamics terms).
+[[gnu::always_inline]] inline void controller_torque(const RobotModel& robot, const RobotData& rd,
+                                                     const JointVector& v_cmd,
+                                                     const JointVector& a_cmd,
+                                                     const JointVector& dq, JointVector& tau) {
+  const ControllerGains& gains = robot.controller;
+  tau = rd.gravity;
+  for (int i = 0; i < robot.dof; ++i) {
+    tau[i] += gains.ka[i] * a_cmd[i] + gains.kv[i] * (v_cmd[i] - dq[i]);
+    if (gains.friction_feedforward) tau[i] += friction_torque(robot.joints[i].friction, v_cmd[i]);
+  }
+}
+
+// At rest after the command: the next edge could start without a jump in velocity,
+// acceleration (jerk) or torque (the next edge starts from holding torque g(q)).
+[[gnu::always_inline]] inline bool at_rest(const Simulator& sim, const RobotData& rd,
+                                           const JointVector& dq, const JointVector& ddq_prev,
+                                           const JointVector& tau, const JointVector& ddq_step_max,
+                                           const JointVector& tau_rate_max) {
+  return (dq.array().abs() <= sim.options.settle_velocity).all() &&
+         within(ddq_prev, ddq_step_max) && within(tau - rd.gravity, tau_rate_max) &&
+         (!sim.options.settle_for_stop || can_stop_dead(sim.robot, rd, dq, ddq_prev, sim.dt));
+}
+
+// The position and velocity limits of the state reached.
+[[gnu::always_inline]] inline RolloutStatus state_limits(const RobotModel& robot,
+                                                         const JointVector& q,
+                                                         const JointVector& dq) {
+  if (!((q.array() > robot.q_min.array()).all() && (q.array() < robot.q_max.array()).all()))
+    return RolloutStatus::PositionLimit;
+  if (!within(dq, robot.dq_max)) return RolloutStatus::VelocityLimit;
+  return RolloutStatus::Valid;
+}
+
 }  // namespace
 
 RolloutResult simulate(const Simulator& sim, SimulatorWorkspace& ws, const JointVectorRef& q0_in,
                        const CommandProfile& profile, TrajectorySamples samples) {
   const RobotModel& robot = sim.robot;
-  const ControllerGains& gains = robot.controller;
   const int n = robot.dof;
   const double dt = sim.dt, h = dt / sim.options.substeps;
   const int sample_every = samples.every > 0 ? samples.every : sim.options.sample_every;
@@ -272,31 +306,20 @@ RolloutResult simulate(const Simulator& sim, SimulatorWorkspace& ws, const Joint
     // Mass matrix, gravity and velocity terms at this tick's state, shared by the controller
     // and the first integration step.
     dynamics_terms(robot, rd, q, dq);
-    // Joint controller: gravity, friction and inertia feed-forward, P on the velocity error.
-    tau = rd.gravity;
-    for (int i = 0; i < n; ++i) {
-      tau[i] += gains.ka[i] * a_cmd[i] + gains.kv[i] * (v_cmd[i] - dq[i]);
-      if (gains.friction_feedforward) tau[i] += friction_torque(robot.joints[i].friction, v_cmd[i]);
-    }
+    controller_torque(robot, rd, v_cmd, a_cmd, dq, tau);
     if (!within(tau, robot.tau_max)) return finish(RolloutStatus::TorqueLimit, tick);
     if (!within(tau - tau_prev, tau_rate_max)) return finish(RolloutStatus::TorqueRateLimit, tick);
     tau_prev = tau;
 
-    // At rest after the command: stop once the next edge could start without a jump in
-    // velocity, acceleration (jerk) or torque (the next edge starts from holding torque g(q)).
-    if (t >= profile.duration && (dq.array().abs() <= sim.options.settle_velocity).all()) {
-      if (within(ddq_prev, ddq_step_max) && within(tau - rd.gravity, tau_rate_max) &&
-          (!sim.options.settle_for_stop || can_stop_dead(robot, rd, dq, ddq_prev, dt))) {
-        if (moved > 0) {
-          const RolloutStatus c = collision_status(sim, ws, q, result.collision_checks);
-          if (c != RolloutStatus::Valid) return finish(c, tick);
-        }
-        if (samples.q && (sample_every <= 0 || tick % sample_every != 0)) {
-          push_sample(samples, q, dq);
-        }
-        if (samples.ticks) push_tick(*samples.ticks, q, dq, ddq_prev, v_cmd);
-        return finish(RolloutStatus::Valid, tick);
+    // Stop once at rest after the command (the last motion collision-checked).
+    if (t >= profile.duration && at_rest(sim, rd, dq, ddq_prev, tau, ddq_step_max, tau_rate_max)) {
+      if (moved > 0) {
+        const RolloutStatus c = collision_status(sim, ws, q, result.collision_checks);
+        if (c != RolloutStatus::Valid) return finish(c, tick);
       }
+      if (samples.q && (sample_every <= 0 || tick % sample_every != 0)) push_sample(samples, q, dq);
+      if (samples.ticks) push_tick(*samples.ticks, q, dq, ddq_prev, v_cmd);
+      return finish(RolloutStatus::Valid, tick);
     }
 
     if (samples.ticks) push_tick(*samples.ticks, q, dq, ddq_prev, v_cmd);
@@ -306,10 +329,8 @@ RolloutResult simulate(const Simulator& sim, SimulatorWorkspace& ws, const Joint
     if (!within(ddq, robot.ddq_max)) return finish(RolloutStatus::AccelerationLimit, tick);
     if (!within(ddq - ddq_prev, ddq_step_max)) return finish(RolloutStatus::JerkLimit, tick);
     ddq_prev = ddq;
-    if (!((q.array() > robot.q_min.array()).all() && (q.array() < robot.q_max.array()).all())) {
-      return finish(RolloutStatus::PositionLimit, tick + 1);
-    }
-    if (!within(dq, robot.dq_max)) return finish(RolloutStatus::VelocityLimit, tick + 1);
+    const RolloutStatus limits = state_limits(robot, q, dq);
+    if (limits != RolloutStatus::Valid) return finish(limits, tick + 1);
 
     result.path_length += (q - q_prev).norm();
     const RolloutStatus c = check_motion(sim, ws, q_prev, q, moved, k.k1q, result.collision_checks);
