@@ -47,10 +47,12 @@ bool edge_ends_near(const PlanningContext& ctx, const JointVectorRef& q, double 
   return false;
 }
 
-BundleSearch::BundleSearch(const PlanningContext& ctx, SimulatorWorkspace& ws,
-                           const PlanningProblem& p, double theta, RolloutPool* pool,
-                           const ParameterValues&)
-    : ctx_(ctx), bundle_(*ctx.bundle), s_(ctx, ws, p), theta_(theta), ahead_(ctx.sim, pool) {}
+BundleSearch::BundleSearch(const BundleSolve& solve)
+    : ctx_(solve.context),
+      bundle_(*solve.context.bundle),
+      s_(solve.context, solve.ws, solve.problem),
+      theta_(solve.theta),
+      ahead_(solve.context.sim, solve.pool) {}
 
 JointVector BundleSearch::edge_end(uint32_t e) const { return row(bundle_.qf(e), bundle_.dof()); }
 JointVector BundleSearch::edge_start(uint32_t e) const { return row(bundle_.q0(e), bundle_.dof()); }

@@ -25,10 +25,20 @@ struct BundleNode : SearchNode {
   bool expanded = false;
 };
 
+// What a bundle planner gives the search it makes for one solve (BundlePlanner): each search
+// takes what it uses.
+struct BundleSolve {
+  const PlanningContext& context;
+  SimulatorWorkspace& ws;
+  const PlanningProblem& problem;
+  double theta;                   // resolved at setup: the parameter, else the context's
+  RolloutPool* pool;              // may run an expansion's rollouts ahead (BoE, LazyBoE)
+  const ParameterValues& values;  // the planner's declared parameters
+};
+
 class BundleSearch {
  public:
-  BundleSearch(const PlanningContext& ctx, SimulatorWorkspace& ws, const PlanningProblem& p,
-               double theta, RolloutPool* pool, const ParameterValues& values = {});
+  explicit BundleSearch(const BundleSolve& solve);
 
   // Checks, at setup, what the search needs beyond a bundle (none here).
   static void check_context(const PlanningContext& /*ctx*/, const ParameterValues& /*values*/) {}
@@ -115,9 +125,9 @@ double bundle_planner_setup(const PlanningContext& context, const ParameterValue
 bool edge_ends_near(const PlanningContext& context, const JointVectorRef& q, double radius,
                     std::vector<std::pair<uint32_t, double>>& scratch);
 
-// A bundle planner: Search (BundleSearch or a subclass, or lazysp's LazySpSearch: any search made
-// from the context, workspace, problem, theta, pool and values) with theta from its parameters
-// or the context.
+// A bundle planner: Search (BundleSearch or a subclass, or lazysp's LazySpSearch: a search made
+// from a BundleSolve, with a static check_context and run()) with theta from its parameters or
+// the context.
 template <class Search>
 class BundlePlanner : public Planner {
  public:
@@ -133,7 +143,7 @@ class BundlePlanner : public Planner {
   PlanResult solve(const PlanningProblem& problem, SimulatorWorkspace& ws,
                    RolloutPool* pool) override {
     if (!context_) fail(name_, "solve before setup");
-    return Search(*context_, ws, problem, theta_, pool, values_).run();
+    return Search(BundleSolve{*context_, ws, problem, theta_, pool, values_}).run();
   }
 
  private:

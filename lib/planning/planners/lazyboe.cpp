@@ -13,11 +13,10 @@ constexpr double kTransferIndex = 1;  // lazy_model's index of "transfer"
 
 class LazySearch : public BundleSearch {
  public:
-  LazySearch(const PlanningContext& ctx, SimulatorWorkspace& ws, const PlanningProblem& p,
-             double theta, RolloutPool* pool, const ParameterValues& values)
-      : BundleSearch(ctx, ws, p, theta, pool),
-        transfer_(values.get("lazy_model") == kTransferIndex),
-        rng_(p.seed, 0) {}
+  explicit LazySearch(const BundleSolve& solve)
+      : BundleSearch(solve),
+        transfer_(solve.values.get("lazy_model") == kTransferIndex),
+        rng_(solve.problem.seed, 0) {}
 
   static void check_context(const PlanningContext& ctx, const ParameterValues& values) {
     if (values.get("lazy_model") == kTransferIndex && !ctx.bundle->has_transfer()) {

@@ -59,15 +59,14 @@ struct LazySpNode : SearchNode {
 
 class LazySpSearch {
  public:
-  // The constructor BundlePlanner calls (the pool is not used: one thread).
-  LazySpSearch(const PlanningContext& ctx, SimulatorWorkspace& ws, const PlanningProblem& p,
-               double theta, RolloutPool*, const ParameterValues& values)
-      : ctx_(ctx),
-        bundle_(*ctx.bundle),
-        s_(ctx, ws, p),
-        set_(settings_of(theta, values)),
-        h_scale_(ctx.mean_displacement > 0 ? 1 + set_.edge_penalty / ctx.mean_displacement : 1),
-        rng_(p.seed, kStream) {}
+  // One thread: the solve's rollout pool is not used.
+  explicit LazySpSearch(const BundleSolve& solve)
+      : ctx_(solve.context),
+        bundle_(*solve.context.bundle),
+        s_(solve.context, solve.ws, solve.problem),
+        set_(settings_of(solve.theta, solve.values)),
+        h_scale_(ctx_.mean_displacement > 0 ? 1 + set_.edge_penalty / ctx_.mean_displacement : 1),
+        rng_(solve.problem.seed, kStream) {}
 
   // Beyond a bundle, the growth needs a sampling box.
   static void check_context(const PlanningContext& ctx, const ParameterValues&) {
