@@ -564,6 +564,7 @@
   stillLayers.render();
   body.setAttribute('data-robot-shapes', String(robot.shapes.length));
   body.setAttribute('data-obstacles', String(data.environment.obstacles.length));
+  body.setAttribute('data-obstacle-types', data.environment.obstacles.map((o) => o.type).join(' '));
   body.setAttribute('data-trajectories', String(trajectories.length));
   body.setAttribute('data-failures', String(failures.length));
   body.setAttribute('data-bundle-points', String(bundle ? bundle.points.length / 3 : 0));

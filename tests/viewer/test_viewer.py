@@ -176,6 +176,29 @@ def obstacles_in(env_path):
     return len(env.get("obstacles", env.get("objects", [])))
 
 
+def scene_with_files(out_dir):
+    """table.json with a box as an OBJ mesh and a point cloud inline (issue 26's obstacle types)."""
+    with open(os.path.join(SOURCE, "data", "environments", "table.json")) as f:
+        scene = json.load(f)
+    corners = [(x, y, z) for x in (-0.05, 0.05) for y in (-0.05, 0.05) for z in (-0.05, 0.05)]
+    faces = [(1, 2, 4), (1, 4, 3), (5, 7, 8), (5, 8, 6), (1, 5, 6), (1, 6, 2),
+             (3, 4, 8), (3, 8, 7), (1, 3, 7), (1, 7, 5), (2, 6, 8), (2, 8, 4)]
+    obj = os.path.join(out_dir, "box.obj")
+    with open(obj, "w") as f:
+        f.writelines(f"v {x} {y} {z}\n" for x, y, z in corners)
+        f.writelines(f"f {a} {b} {c}\n" for a, b, c in faces)
+    rng = random.Random(5)
+    points = [[0.45 + 0.1 * rng.random(), -0.35 + 0.1 * rng.random(), 0.3 + 0.1 * rng.random()]
+              for _ in range(300)]
+    scene["name"] = "files"
+    scene["objects"] += [{"name": "box", "type": "mesh", "file": obj, "position": [0.5, 0.3, 0.35]},
+                         {"name": "cloud", "type": "points", "points": points, "resolution": 0.02}]
+    path = os.path.join(out_dir, "files.json")
+    with open(path, "w") as f:
+        json.dump(scene, f)
+    return path, len(scene["objects"])
+
+
 def main():
     bin_dir, out_dir = sys.argv[1], sys.argv[2]
     binary = chromium.find_chromium()
@@ -202,6 +225,9 @@ def main():
     run([tool, "--results", write_lines(os.path.join(out_dir, "failed.jsonl"),
                                         [failed_result("d", 4, "search exhausted")]),
          "--queries", queries, "--out", only_failed])
+    files_scene, files_obstacles = scene_with_files(out_dir)
+    files_page = os.path.join(out_dir, "files.html")
+    run([tool, "--results", results, "--queries", queries, "--env", files_scene, "--out", files_page])
     no_trajectories = os.path.join(out_dir, "none.html")
     bare = trajectory_result("a", 1, READY, OTHER)
     del bare["trajectory"]
@@ -242,6 +268,12 @@ def main():
         browser.console_errors.clear()
 
         cached_equals_direct(browser, main_page, out_dir)
+
+        state = open_page(browser, files_page, "mesh and point-cloud page")
+        types = state.get("obstacleTypes", "").split()
+        check(state.get("obstacles") == str(files_obstacles) and "mesh" in types and "cells" in types,
+              f"mesh and point-cloud page: every obstacle, the mesh and the cloud's cells drawn ({types})")
+        nonblank_robot(browser, os.path.join(out_dir, "files.png"), "mesh and point-cloud page")
 
         state = open_page(browser, only_failed, "failed-only page")
         text = browser.evaluate("document.body.innerText")
