@@ -16,6 +16,7 @@
 #include "lazyboe/common/json_fields.h"
 #include "lazyboe/common/progress.h"
 #include "lazyboe/common/version.h"
+#include "lazyboe/io/bundle_report.h"
 #include "lazyboe/planning/edge_index_file.h"
 #include "lazyboe/planning/workspace_index.h"
 #include "mpi_build.h"

@@ -7,7 +7,6 @@
 // Format: schemas/bundle.md, "k-d tree index".
 #pragma once
 
-#include <cstdio>
 #include <string>
 
 #include "lazyboe/bundle/bundle_view.h"
@@ -30,10 +29,6 @@ BundleIndexes load_bundle_indexes(const BundleView& bundle, bool memory_map);
 // One line on the index beside the bundle: its path and whether planning uses it (checked as a
 // session checks it), or why not.
 std::string bundle_index_status(const BundleView& bundle);
-
-// The end of --inspect (and of the Python module's inspect()): the files beside the bundle at
-// `path`, its k-d tree index and any checkpoint journal.
-void print_files_beside(const std::string& path, std::FILE* out);
 
 // Builds both trees of the bundle and writes them to edge_index_path(bundle.path()), atomically
 // (a temporary file renamed into place). Throws Error naming the index path when it cannot be

@@ -9,7 +9,7 @@
 #include "convert.h"
 #include "lazyboe/bundle/bundle_view.h"
 #include "lazyboe/bundle/inspect.h"
-#include "lazyboe/planning/edge_index_file.h"
+#include "lazyboe/io/bundle_report.h"
 
 namespace lazyboe::python {
 
