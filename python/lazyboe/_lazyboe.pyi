@@ -109,6 +109,7 @@ class Scene:
     name: str
     hash: str
     obstacles: list[str]
+    marked_edges: int | None
 
 class PlanningSession:
     robot: Robot

@@ -427,6 +427,15 @@ void bind_scene(py::module_& m) {
             return names;
           },
           "The obstacles' names.")
+      .def_property_readonly(
+          "marked_edges",
+          [](const PyScene& p) -> py::object {
+            if (!p.world->edge_marks) return py::none();
+            return py::int_(p.world->edge_marks->marked);
+          },
+          "How many bundle edges the scene's new obstacles may block (the workspace index's "
+          "marks, which steer lazysp and LazyBoE); None for the bundle's own scene or without "
+          "an index.")
       .def("__repr__", [](const PyScene& p) {
         return "<lazyboe.Scene " + p.world->env.name + " " + p.world->env.identity + ">";
       });

@@ -95,3 +95,7 @@ def test_the_workspace_index_steers_lazysp_in_another_scene(session, bundle_path
         START, {"q": GOAL, "tolerance": 0.1}, **kwargs)
     assert mixed.success
     assert without_timings(mixed.to_dict()) == without_timings(alone.to_dict())
+    # The table's obstacles are new to a bundle built on the floor alone: some edges are marked.
+    table = session.load_scene(TABLE)
+    assert 0 < table.marked_edges < session.bundle.size
+    assert session.load_scene(empty_env()).marked_edges is None  # the bundle's own scene
