@@ -156,6 +156,8 @@ TEST(BenchCli, TinyStudyWritesEveryFileWithConsistentRows) {
   EXPECT_TRUE(contains(summary, "Mann-Whitney U")) << summary;
   EXPECT_TRUE(contains(summary, "## Targets")) << summary;
   EXPECT_TRUE(contains(summary, "## Execution")) << summary;
+  EXPECT_TRUE(contains(summary, "- A single straight command (start to goal")) << summary;
+  EXPECT_TRUE(contains(summary, " of 2 problems: those need no planning")) << summary;
   EXPECT_TRUE(fs::exists(dir + "/study.json"));
   EXPECT_FALSE(fs::exists(dir + "/runs.partial.csv"));
   for (const char* figure :

@@ -18,6 +18,7 @@
 #include "cli_util.h"
 #include "lazyboe/bundle/bundle_file.h"
 #include "lazyboe/bundle/bundle_view.h"
+#include "lazyboe/planning/execution.h"
 #include "lazyboe/planning/planning_session.h"
 #include "lazyboe/planning/request.h"
 #include "lazyboe/robot/kinematics.h"
@@ -354,6 +355,30 @@ TEST(Scenes, LazyspPlansWithTheWorkspaceIndexInANewScene) {
       answers.back().push_back(timeless(json::parse(line)));
   }
   EXPECT_EQ(answers[0], answers[1]);
+}
+
+// The bench's count of problems that need no planning: one direct command solves the open
+// table's problem, not the same problem with a ball on the straight line, nor a position goal.
+TEST(Scenes, ADirectCommandSolvesTheOpenProblemOnly) {
+  const Fixture& f = fixture();
+  PlanningProblem p;
+  p.start = f.start;
+  p.goal.q = f.goal;
+  p.goal.tolerance = 0.3;
+  const PlanningContext open = f.session.context();
+  SimulatorWorkspace ws(f.session.sim());
+  EXPECT_TRUE(solved_by_direct_command(open.sim, ws, open.command, p));
+
+  const json line = {
+      {"trajectory", {{"q", {vec(f.start), vec((f.start + f.goal) / 2), vec(f.goal)}}}}};
+  const WorldPtr blocked =
+      f.session.scenes.inline_scene(JsonField(blocked_scene(line, kBall), "ball", ""));
+  const PlanningContext there = f.session.context(*blocked);
+  EXPECT_FALSE(solved_by_direct_command(there.sim, ws, there.command, p));
+
+  PlanningProblem position = p;
+  position.goal.kind = Goal::Kind::Position;
+  EXPECT_FALSE(solved_by_direct_command(open.sim, ws, open.command, position));
 }
 
 TEST(Scenes, AnEnvironmentForAnotherRobotIsRefusedWithOneLine) {

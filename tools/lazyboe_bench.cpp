@@ -282,14 +282,16 @@ void write_results(const BenchOptions& o, const StudyPaths& paths, const StudyIn
   }
 }
 
-StudyInfo study_info(const BenchOptions& o, const PlanningSession& session, int problems,
-                     const std::string& problems_source, const std::string& command_line) {
+StudyInfo study_info(const BenchOptions& o, const PlanningSession& session,
+                     const std::vector<BenchProblem>& problems, const std::string& problems_source,
+                     const std::string& command_line) {
   StudyInfo info;
+  info.direct = direct_solutions(session.context(), problems);
   info.bundle = o.bundle_path;
   info.edges = session.bundle.size();
   info.robot = session.robot.config_path;
   info.environment = session.world().env.path;
-  info.problems = problems;
+  info.problems = static_cast<int>(problems.size());
   info.problems_source = problems_source;
   info.repeats = o.repeats;
   info.jobs = o.jobs;
@@ -363,8 +365,7 @@ int run(const BenchOptions& o, const std::string& command_line) {
                  runs.size(), paths.partial.c_str());
     return 130;
   }
-  const StudyInfo info =
-      study_info(o, session, static_cast<int>(problems.size()), problems_source, command_line);
+  const StudyInfo info = study_info(o, session, problems, problems_source, command_line);
   write_results(o, paths, info, specs, runs, problem_ids);
   return 0;
 }

@@ -369,6 +369,12 @@ std::string summary_markdown(const StudyInfo& info, const std::vector<PlannerSpe
   md << "- Problems: " << info.problems << " (" << info.problems_source << "), repeats "
      << info.repeats << ", budget " << fixed(info.budget, 1) << " s per run, study seed "
      << info.seed << ", " << info.jobs << " run(s) in parallel\n";
+  if (info.direct >= 0)
+    md << "- A single straight command (start to goal, rest to rest, within the bundle's command "
+          "limits, every check) solves "
+       << info.direct << " of " << info.problems
+       << " problems: those need no planning, and the post-processing's first shortcut finds "
+          "them whatever the planner\n";
   md << "- Machine: " << info.machine << "\n";
   md << "- Command: `" << info.command_line << "`\n\n";
   md << "Time to first solution and final cost are over the successful runs; the number of "

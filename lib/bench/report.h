@@ -48,6 +48,7 @@ struct StudyInfo {
   int problems = 0, repeats = 0, jobs = 0;
   double budget = 0;
   uint64_t seed = 0;
+  int direct = -1;  // problems one direct command solves (solved_by_direct_command); -1: unknown
 };
 
 // summary.md as text: the planners in `specs` order, unavailable ones listed as skipped.

@@ -230,4 +230,16 @@ std::vector<RunRecord> run_study(const PlanningContext& context,
   return runs;
 }
 
+int direct_solutions(const PlanningContext& context, const std::vector<BenchProblem>& problems) {
+  SimulatorWorkspace ws(context.sim);
+  int solved = 0;
+  for (const BenchProblem& b : problems) {
+    PlanningProblem p;
+    p.start = b.start;
+    p.goal = b.goal;
+    solved += solved_by_direct_command(context.sim, ws, context.command, p);
+  }
+  return solved;
+}
+
 }  // namespace lazyboe

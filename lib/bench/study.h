@@ -24,6 +24,10 @@ struct StudyVariant {
 // A planner's study variants; empty: studies run the planner itself.
 const std::vector<StudyVariant>& study_variants(const std::string& planner);
 
+// How many of `problems` one direct command solves in the context's world
+// (solved_by_direct_command with the context's command limits).
+int direct_solutions(const PlanningContext& context, const std::vector<BenchProblem>& problems);
+
 struct PlannerSpec {
   std::string name;            // as in runs.csv: lazyboe, boe, rrt, sst-0.5x, ..., ompl-sst
   std::string planner;         // its name in the planner registry

@@ -490,4 +490,17 @@ ExecutableTrajectory make_executable(const Simulator& sim, SimulatorWorkspace& w
   return out;
 }
 
+bool solved_by_direct_command(const Simulator& sim, SimulatorWorkspace& ws,
+                              const CommandSampling& limits, const PlanningProblem& problem) {
+  const Goal& goal = problem.goal;
+  if (goal.kind != Goal::Kind::Joint) return false;
+  std::vector<double> times, knots;
+  if (!direct_command(sim.robot, limits, goal.q - problem.start, sim.dt, times, knots))
+    return false;
+  const CommandProfile profile{knots.data(), static_cast<int>(times.size()), sim.robot.dof,
+                               times.back(), times.data()};
+  const RolloutResult r = simulate(sim, ws, problem.start, profile);
+  return r.valid() && goal.contains(sim.robot, ws.robot, r.qf);
+}
+
 }  // namespace lazyboe

@@ -104,4 +104,10 @@ bool direct_command(const RobotModel& robot, const CommandSampling& limits,
                     const JointVectorRef& displacement, double dt, std::vector<double>& times,
                     std::vector<double>& knots);
 
+// Whether one direct command from the problem's start to its joint goal (direct_command within
+// `limits`), simulated with every check, ends at rest inside the goal region: a problem that
+// needs no planning. False for a position goal (no joint target to aim at).
+bool solved_by_direct_command(const Simulator& sim, SimulatorWorkspace& ws,
+                              const CommandSampling& limits, const PlanningProblem& problem);
+
 }  // namespace lazyboe
