@@ -107,6 +107,20 @@ TEST(QueryCli, MemoryMappedAndReadIntoMemoryGiveIdenticalAnswers) {
   EXPECT_TRUE(contains(loud.r.err, "read into memory")) << loud.r.err;
 }
 
+// A JSON array, as pretty-printed JSON tools write one, is one clear error for the file (not one
+// "not valid JSON" result per line), and nothing is written.
+TEST(QueryCli, AJsonArrayIsOneErrorNamingTheFormat) {
+  const Fixture& f = fixture();
+  const nlohmann::json batch = {query("a", f.a, f.b, "boe", 1, true),
+                                query("b", f.b, f.a, "boe", 1, true)};
+  const std::string dir = fresh_dir("array");
+  const std::string file = write_temp_file("array/batch.json", batch.dump(2) + "\n");
+  const ToolRun t =
+      query_tool({"--bundle", f.path, "--queries", file, "--out", dir + "/r.jsonl", "--quiet"});
+  expect_one_line_error(t.r, {file, "line 1: a JSON array", "JSON Lines", "jq -c"});
+  EXPECT_EQ(files_in(dir), std::vector<std::string>{"batch.json"});
+}
+
 TEST(QueryCli, IncompleteMissingAndUnperturbedBundlesAreRefused) {
   const Fixture& f = fixture();
   // Incomplete: the resume hint.

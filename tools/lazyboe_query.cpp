@@ -185,6 +185,17 @@ std::vector<Outcome> answer_stream(const Job& job, std::ostream& out, int sim_th
 }
 
 // A file: `jobs` queries at a time, results in input order.
+// A JSON array (pretty-printed or not) is not JSON Lines: one error for the file, not one per line.
+void refuse_json_array(const std::string& path,
+                       const std::vector<std::pair<int, std::string>>& lines) {
+  if (lines.empty()) return;
+  const std::string& first = lines.front().second;
+  if (first[first.find_first_not_of(" \t\r")] != '[') return;
+  fail(path, "line " + std::to_string(lines.front().first) +
+                 ": a JSON array; a query file is JSON Lines, one query object per line (jq -c "
+                 "'.[]' FILE converts an array)");
+}
+
 std::vector<Outcome> answer_file(const Job& job, const std::string& path, std::ostream& out,
                                  int jobs, int sim_threads) {
   require_input_file(path, "--queries");
@@ -195,6 +206,7 @@ std::vector<Outcome> answer_file(const Job& job, const std::string& path, std::o
   for (int line = 1; std::getline(in, text); ++line) {
     if (text.find_first_not_of(" \t\r") != std::string::npos) lines.emplace_back(line, text);
   }
+  refuse_json_array(path, lines);
   std::vector<Outcome> outcomes(lines.size());
   std::vector<SimulatorWorkspace> workspaces;
   std::vector<std::unique_ptr<RolloutPool>> pools;  // not movable: they own threads
@@ -240,6 +252,18 @@ void print_summary(const std::vector<Outcome>& outcomes) {
   std::fprintf(stderr, "resident memory %.0f MiB\n", resident_memory_mib());
 }
 
+// Every query of a non-empty batch had an error: the exit status says so (results are written).
+bool every_query_failed_to_parse(const std::vector<Outcome>& outcomes) {
+  for (const Outcome& o : outcomes)
+    if (!o.error) return false;
+  if (outcomes.empty()) return false;
+  std::fprintf(stderr,
+               "lazyboe-query: every query had an error (%zu of %zu; see their \"error\" "
+               "field)\n",
+               outcomes.size(), outcomes.size());
+  return true;
+}
+
 // The default --sim-threads: the cores left per job; a warning when jobs x threads exceed them.
 int sim_threads_for(const Options& o) {
   const int cores = omp_get_num_procs();
@@ -281,7 +305,7 @@ int run(const Options& o) {
                             : answer_file(job, o.queries_path, out, o.jobs, sim_threads);
   if (file) file->commit();
   if (!o.quiet) print_summary(outcomes);
-  return 0;
+  return every_query_failed_to_parse(outcomes) ? 1 : 0;
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 import json
 import os
 import signal
+import subprocess
 import time
 import threading
 
@@ -10,7 +11,7 @@ import numpy as np
 import pytest
 
 import lazyboe
-from conftest import GOAL, START, tool, without_timings
+from conftest import GOAL, START, TOOLS, tool, without_timings
 
 # Queries every planner family answers deterministically (stop_at_first, generous budget).
 QUERIES = [
@@ -164,8 +165,11 @@ def test_message_is_the_librarys(session, bundle_path, tmp_path):
     bad = query({"id": "bad", "goal": {"q": [9.0] * 7}})
     f = tmp_path / "bad.jsonl"
     f.write_text(json.dumps(bad) + "\n")
-    line = json.loads(tool("lazyboe-query", "--bundle", bundle_path, "--queries", f,
-                           "--quiet").stdout)
+    # Every query of the batch had an error: exit status 1, the error result written all the same.
+    r = subprocess.run([str(TOOLS / "lazyboe-query"), "--bundle", str(bundle_path), "--queries",
+                        str(f), "--quiet"], capture_output=True, text=True)
+    assert r.returncode == 1 and "every query had an error (1 of 1" in r.stderr
+    line = json.loads(r.stdout)
     with pytest.raises(ValueError) as e:
         session.plan_many([bad])
     assert line["error"] == "line 1: " + str(e.value).removeprefix("queries[0]: ")
