@@ -237,7 +237,13 @@ TEST(ValidateProblem, AcceptsAValidProblem) {
 TEST(ValidateProblem, NamesTheFieldAndTheReason) {
   PlanningProblem p = ready_problem();
   p.start[3] = 0.5;  // joint 4's upper limit is -0.0698
-  EXPECT_EQ(issue(p), "start: outside the joint limits");
+  EXPECT_EQ(issue(p),
+            "start: outside the joint limits: joint 4 (panda_joint4) is 0.5, its limits (-3.0718, "
+            "-0.0698)");
+  p.start << 0, -45, 0, -135, 0, 90, 45;  // degrees
+  EXPECT_EQ(issue(p),
+            "start: outside the joint limits: joint 2 (panda_joint2) is -45, its limits (-1.7628, "
+            "1.7628) (joint values are in rad, not degrees)");
   p = ready_problem();
   p.goal.q = JointVector::Zero(6);
   EXPECT_EQ(issue(p), "goal.q: expected 7 joint values");

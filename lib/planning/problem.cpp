@@ -1,5 +1,8 @@
 #include "lazyboe/planning/problem.h"
 
+#include <cmath>
+#include <cstdio>
+
 #include "lazyboe/common/error.h"
 
 namespace lazyboe {
@@ -12,13 +15,29 @@ double Goal::distance(const RobotModel& robot, RobotData& data, const JointVecto
 
 namespace {
 
+// Which joint is outside its limits (as check_state tests them: strictly inside), by how much,
+// and, when the values look like degrees, that they are radians.
+std::string limits_issue(const RobotModel& robot, const JointVector& q) {
+  std::string out = "outside the joint limits";
+  for (int i = 0; i < robot.dof; ++i) {
+    if (q[i] > robot.q_min[i] && q[i] < robot.q_max[i]) continue;
+    char detail[200];
+    std::snprintf(detail, sizeof detail, ": joint %d (%s) is %.6g, its limits (%.6g, %.6g)", i + 1,
+                  robot.joints[i].name.c_str(), q[i], robot.q_min[i], robot.q_max[i]);
+    out += detail;
+    break;
+  }
+  if (q.cwiseAbs().maxCoeff() > 2 * M_PI) out += " (joint values are in rad, not degrees)";
+  return out;
+}
+
 ProblemIssue state_issue(const Simulator& sim, SimulatorWorkspace& ws, const std::string& field,
                          const JointVector& q) {
   const int n = sim.robot.dof;
   if (q.size() != n) return {field, "expected " + std::to_string(n) + " joint values"};
   switch (check_state(sim, ws, q)) {
     case RolloutStatus::PositionLimit:
-      return {field, "outside the joint limits"};
+      return {field, limits_issue(sim.robot, q)};
     case RolloutStatus::SelfCollision:
       return {field, "in self-collision"};
     case RolloutStatus::EnvCollision:
