@@ -69,10 +69,10 @@ void append_varint(std::vector<uint8_t>& out, uint64_t v) {
 
 // The grid around every cell any edge's links can reach.
 WorkspaceGrid make_grid(const BundleView& bundle, const RobotModel& robot,
-                        const std::vector<SweptShape>& shapes, double cell) {
+                        const std::vector<SweptShape>& shapes, double cell, int threads) {
   Eigen::Vector3d lower = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
   Eigen::Vector3d upper = -lower;
-#pragma omp parallel
+#pragma omp parallel num_threads(threads)
   {
     RobotData data(robot);
     std::vector<Segment> segments;
@@ -106,7 +106,7 @@ WorkspaceGrid make_grid(const BundleView& bundle, const RobotModel& robot,
 std::vector<std::vector<uint8_t>> sweep_lists(const BundleView& bundle, const RobotModel& robot,
                                               const std::vector<SweptShape>& shapes, size_t links,
                                               const WorkspaceGrid& grid,
-                                              const WorkspaceIndexOptions& options,
+                                              const WorkspaceIndexOptions& options, int threads,
                                               uint64_t& entries) {
   const size_t keys = grid.cells() * links;
   std::vector<std::vector<uint8_t>> lists(keys);
@@ -114,7 +114,7 @@ std::vector<std::vector<uint8_t>> sweep_lists(const BundleView& bundle, const Ro
   std::vector<std::vector<uint32_t>> swept(kChunk);
   for (size_t begin = 0; begin < bundle.size(); begin += kChunk) {
     const size_t end = std::min(bundle.size(), begin + kChunk);
-#pragma omp parallel
+#pragma omp parallel num_threads(threads)
     {
       RobotData data(robot);
       std::vector<Segment> segments;
@@ -141,7 +141,7 @@ std::vector<std::vector<uint8_t>> sweep_lists(const BundleView& bundle, const Ro
 // Why the header does not describe an index of `bundle` and `robot` in a file of `size` bytes;
 // "" if it does.
 std::string mismatch(const IndexHeader& h, const BundleView& bundle, const std::string& names,
-                     size_t size) {
+                     size_t links, size_t size) {
   if (std::memcmp(h.magic, kMagic, sizeof kMagic) != 0) return "not a workspace index";
   if (h.version != kVersion) return "workspace index format version " + std::to_string(h.version);
   const std::string stored(h.states_checksum, strnlen(h.states_checksum, sizeof h.states_checksum));
@@ -157,8 +157,7 @@ std::string mismatch(const IndexHeader& h, const BundleView& bundle, const std::
   if (keys > kMaxKeys || h.names_bytes % 8 != 0 || h.list_bytes % 8 != 0 || h.names_bytes > size ||
       h.list_bytes > size || size != kHeaderBytes + h.names_bytes + 8 * (keys + 1) + h.list_bytes)
     return "truncated or malformed";
-  if (h.names_bytes != names.size() || h.links != static_cast<uint32_t>(count_links(names)))
-    return "made for another robot's links";
+  if (h.names_bytes != names.size() || h.links != links) return "made for another robot's links";
   return "";
 }
 
@@ -191,16 +190,13 @@ WorkspaceIndexSummary write_workspace_index(const BundleView& bundle, const Robo
   std::vector<int> links;
   const std::vector<SweptShape> shapes = swept_shapes(robot, links);
   const int threads = options.threads > 0 ? options.threads : omp_get_num_procs();
-  const int saved = omp_get_max_threads();
-  omp_set_num_threads(threads);
   WorkspaceIndexSummary out;
-  out.grid = make_grid(bundle, robot, shapes, options.cell);
+  out.grid = make_grid(bundle, robot, shapes, options.cell, threads);
   out.links = links.size();
   if (out.grid.cells() * links.size() > kMaxKeys)
     fail(path, "a cell of " + std::to_string(options.cell) + " m makes too many cells");
   const std::vector<std::vector<uint8_t>> lists =
-      sweep_lists(bundle, robot, shapes, links.size(), out.grid, options, out.entries);
-  omp_set_num_threads(saved);
+      sweep_lists(bundle, robot, shapes, links.size(), out.grid, options, threads, out.entries);
 
   IndexHeader h{};
   const std::string states = bundle_states_fingerprint(bundle);
@@ -245,7 +241,7 @@ std::shared_ptr<const WorkspaceIndex> WorkspaceIndex::open(const BundleView& bun
   std::vector<int> links;
   swept_shapes(robot, links);
   const std::string names = names_block(robot, links);
-  const std::string why = mismatch(h, bundle, names, f.size);
+  const std::string why = mismatch(h, bundle, names, links.size(), f.size);
   if (!why.empty()) fail(path, why);
   if (std::memcmp(f.data + kHeaderBytes, names.data(), names.size()) != 0)
     fail(path, "made for another robot's links");

@@ -60,13 +60,6 @@ std::vector<SweptShape> swept_shapes(const RobotModel& robot, std::vector<int>& 
   return shapes;
 }
 
-size_t count_links(const std::string& names) {
-  size_t count = 0;
-  for (size_t i = 0; i < names.size(); ++i)
-    count += names[i] != '\0' && (i == 0 || names[i - 1] == '\0');
-  return count;
-}
-
 void sweep_segments(const BundleView& bundle, const RobotModel& robot,
                     const std::vector<SweptShape>& shapes, size_t edge, RobotData& data,
                     std::vector<Segment>& segments) {

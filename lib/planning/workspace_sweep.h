@@ -36,9 +36,6 @@ struct Segment {
 // the order of the robot's collision bodies). Throws Error for more than kMaxLinks links.
 std::vector<SweptShape> swept_shapes(const RobotModel& robot, std::vector<int>& links);
 
-// Number of names in a NUL-separated names block (the index file's).
-size_t count_links(const std::string& names);
-
 // segments[i * shapes.size() + s]: shape s at stored sample i of `edge`.
 void sweep_segments(const BundleView& bundle, const RobotModel& robot,
                     const std::vector<SweptShape>& shapes, size_t edge, RobotData& data,
