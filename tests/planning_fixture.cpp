@@ -165,6 +165,12 @@ bool is_bundle_planner(const std::string& planner) {
   return info && info->needs.bundle;
 }
 
+ParameterValues searching(const std::string& planner, ParameterValues values) {
+  const PlannerInfo* info = find_planner(planner);
+  if (info && info->parameter("direct")) values.set("direct", 0);
+  return values;
+}
+
 double easy_budget(const std::string& planner) { return is_bundle_planner(planner) ? 1.5 : 3.0; }
 
 // ------------------------------------------------------------------------------------------

@@ -17,6 +17,7 @@
 #include "lazyboe/collision/collision_model.h"
 #include "lazyboe/collision/environment.h"
 #include "lazyboe/planning/neighbour_index.h"
+#include "lazyboe/planning/parameters.h"
 #include "lazyboe/planning/problem.h"
 #include "lazyboe/robot/robot_model.h"
 #include "lazyboe/sim/simulator.h"
@@ -93,6 +94,9 @@ std::vector<std::string> own_planners();
 inline const std::vector<std::string> kPlanners = own_planners();
 
 bool is_bundle_planner(const std::string& planner);
+// `values` with direct = false for a planner that declares `direct`: tests of a search run the
+// search, not the straight command tried before it (tested on its own in test_execution).
+ParameterValues searching(const std::string& planner, ParameterValues values = {});
 double easy_budget(const std::string& planner);  // of the easy problem a -> b
 
 // ------------------------------------------------------------------------------------------

@@ -80,7 +80,7 @@ std::vector<std::string> fields_of(const std::string& line) {
 const std::string kHeader =
     "planner,problem,repeat,seed,success,time_to_first_solution,best_cost,n_solutions,nodes,"
     "simulations,lazy_edges,collision_checks,budget,failure,duration,stops,arc_length,"
-    "raw_duration,raw_stops,post_seconds,junctions,blends_kept,shortcuts";
+    "raw_duration,raw_stops,post_seconds,junctions,blends_kept,shortcuts,found_by";
 
 bool matplotlib_installed() {
   return std::system("/usr/bin/python3 -c 'import matplotlib' > /dev/null 2>&1") == 0;
@@ -92,7 +92,7 @@ bool matplotlib_installed() {
 void expect_consistent_rows(const std::vector<std::string>& rows, double budget) {
   for (size_t k = 1; k < rows.size(); ++k) {
     const std::vector<std::string> f = fields_of(rows[k]);
-    ASSERT_EQ(f.size(), 23u) << rows[k];
+    ASSERT_EQ(f.size(), 24u) << rows[k];
     EXPECT_GT(std::stoull(f[9]), 0u) << "a run that simulated nothing: " << rows[k];
     if (f[4] == "1") {
       EXPECT_LE(std::stod(f[5]), budget + 0.5 * time_scale()) << rows[k];
@@ -112,7 +112,7 @@ void expect_consistent_rows(const std::vector<std::string>& rows, double budget)
 TEST(BenchCli, TinyStudyWritesEveryFileWithConsistentRows) {
   const std::string dir = fresh_dir("study");
   const CommandResult r =
-      bench("--problems 2 " + budget(1) + " --jobs 2 --seed 3 --out " + quote(dir));
+      bench("--problems 2 " + budget(1) + " --jobs 2 --seed 3 --no-direct --out " + quote(dir));
   ASSERT_EQ(r.exit_code, 0) << describe(r);
 
   const std::vector<std::string> problems = lines_of(read_file(dir + "/problems.jsonl"));
@@ -137,6 +137,7 @@ TEST(BenchCli, TinyStudyWritesEveryFileWithConsistentRows) {
   for (size_t k = 1; k < rows.size(); ++k) {
     const std::vector<std::string> f = fields_of(rows[k]);
     if (f[0] == "lazyboe") lazy_edges += std::stoull(f[10]);
+    EXPECT_NE(f[23], "direct") << "--no-direct, and yet: " << rows[k];
     const bool lazy_planner = f[0] == "lazyboe" || f[0] == "lazyboe-transfer" || f[0] == "lazysp";
     if (!lazy_planner) {  // lazysp's: the predicted states it kept
       EXPECT_EQ(f[10], "0") << "only LazyBoE and lazysp take lazy edges: " << rows[k];
@@ -169,10 +170,11 @@ TEST(BenchCli, TinyStudyWritesEveryFileWithConsistentRows) {
     }
   }
 
-  // The problems file repeats the study's problems exactly.
+  // The problems file repeats the study's problems exactly; boe now tries the straight command
+  // first (no --no-direct), and answers with it exactly the problems it solves.
   const std::string again = fresh_dir("study-again");
   const CommandResult r2 = bench("--problems-file " + quote(dir + "/problems.jsonl") +
-                                 " --planners rrt,sst-1x --repeats 2 " + budget(0.3) +
+                                 " --planners rrt,boe --repeats 2 " + budget(0.3) +
                                  " --no-figures --quiet --seed 3 "
                                  "--out " +
                                  quote(again));
@@ -191,6 +193,18 @@ TEST(BenchCli, TinyStudyWritesEveryFileWithConsistentRows) {
   }
   EXPECT_EQ(seeds.size(), 4u);
   for (const auto& [key, s] : seeds) EXPECT_EQ(s.size(), 1u) << key.first << " " << key.second;
+  int direct_rows = 0;
+  for (size_t k = 1; k < repeated.size(); ++k) {
+    const std::vector<std::string> f = fields_of(repeated[k]);
+    if (f[23] != "direct") continue;
+    EXPECT_EQ(f[0], "boe") << "only the bundle planners try the straight command: " << repeated[k];
+    EXPECT_EQ(f[9], "1") << "one simulation: " << repeated[k];
+    ++direct_rows;
+  }
+  const std::string summary2 = read_file(again + "/summary.md");
+  const size_t at = summary2.find(") solves ");
+  ASSERT_NE(at, std::string::npos) << summary2;
+  EXPECT_EQ(direct_rows, 2 * std::stoi(summary2.substr(at + 9))) << summary2;  // 2 repeats
   EXPECT_EQ(all_seeds.size(), 4u);
   for (size_t k = 1; k < rows.size(); ++k) {
     const std::vector<std::string> f = fields_of(rows[k]);
@@ -307,7 +321,9 @@ TEST(BenchRuns, PartialFileSurvivesATornRowAndRejectsBadFields) {
   a.stops = 1;
   a.raw_duration = 2.5;
   a.raw_stops = 3;
+  a.found_by = "direct";
   RunRecord b = a;
+  b.found_by.clear();
   b.problem = 1;
   b.success = false;
   b.time_to_first_solution = b.best_cost = std::numeric_limits<double>::quiet_NaN();
@@ -334,23 +350,25 @@ TEST(BenchRuns, PartialFileSurvivesATornRowAndRejectsBadFields) {
   EXPECT_DOUBLE_EQ(runs[0].raw_duration, 2.5);
   EXPECT_EQ(runs[0].raw_stops, 3);
   EXPECT_EQ(runs[0].junctions, -1);
+  EXPECT_EQ(runs[0].found_by, "direct");
   EXPECT_FALSE(runs[1].success);
+  EXPECT_EQ(runs[1].found_by, "");
   EXPECT_EQ(runs[1].failure, b.failure);
   EXPECT_TRUE(std::isnan(runs[1].time_to_first_solution));
 
   const std::string header = lines_of(whole)[0];
   for (const auto& [row, field] : std::vector<std::pair<std::string, std::string>>{
-           {"rrt,p0,0,-5,1,0.5,1.25,1,0,7,0,0,1,,,,,,,,,,", "seed"},
-           {"rrt,p0,0,42,yes,0.5,1.25,1,0,7,0,0,1,,,,,,,,,,", "success"},
-           {"rrt,p0,0,42,1,0.5,1.25,1.7,0,7,0,0,1,,,,,,,,,,", "n_solutions"},
-           {"rrt,p0,0,42,1,0.5,1.25,1,0,,0,0,1,,,,,,,,,,", "simulations"},
-           {"rrt,p9,0,42,1,0.5,1.25,1,0,7,0,0,1,,,,,,,,,,", "problem"},
-           {"rrt,p0,0,42,1,0.5,1.25,1,0,7,0,0,1,,fast,,,,,,,,", "duration"},
-           {"rrt,p0,0,42,1,0.5,1.25,1,0,7,0,0,1,,1.0,-1,,,,,,,", "stops"},
+           {"rrt,p0,0,-5,1,0.5,1.25,1,0,7,0,0,1,,,,,,,,,,,", "seed"},
+           {"rrt,p0,0,42,yes,0.5,1.25,1,0,7,0,0,1,,,,,,,,,,,", "success"},
+           {"rrt,p0,0,42,1,0.5,1.25,1.7,0,7,0,0,1,,,,,,,,,,,", "n_solutions"},
+           {"rrt,p0,0,42,1,0.5,1.25,1,0,,0,0,1,,,,,,,,,,,", "simulations"},
+           {"rrt,p9,0,42,1,0.5,1.25,1,0,7,0,0,1,,,,,,,,,,,", "problem"},
+           {"rrt,p0,0,42,1,0.5,1.25,1,0,7,0,0,1,,fast,,,,,,,,,", "duration"},
+           {"rrt,p0,0,42,1,0.5,1.25,1,0,7,0,0,1,,1.0,-1,,,,,,,,", "stops"},
            // Found by fuzzing: counts past the int range wrapped (4294967297 read as 1).
-           {"rrt,p0,4294967297,42,1,0.5,1.25,1,0,7,0,0,1,,,,,,,,,,", "repeat"},
-           {"rrt,p0,0,42,1,0.5,1.25,2147483648,0,7,0,0,1,,,,,,,,,,", "n_solutions"},
-           {"rrt,p0,0,42,1,0.5,1.25,1,0,7,0,0,1,,1.0,4294967296,,,,,,,", "stops"}}) {
+           {"rrt,p0,4294967297,42,1,0.5,1.25,1,0,7,0,0,1,,,,,,,,,,,", "repeat"},
+           {"rrt,p0,0,42,1,0.5,1.25,2147483648,0,7,0,0,1,,,,,,,,,,,", "n_solutions"},
+           {"rrt,p0,0,42,1,0.5,1.25,1,0,7,0,0,1,,1.0,4294967296,,,,,,,,", "stops"}}) {
     write_bytes(path, header + "\n" + row + "\n");
     try {
       read_runs_csv(path, ids);

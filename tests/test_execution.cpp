@@ -5,7 +5,9 @@
 // junction, clear of the raw chain) keeps its stop; first and last samples at rest; the stage
 // without blending or shortcuts is the raw chain bit for bit; the same output on every run and
 // with any thread count (test_query_cli); commands with knot times evaluate as evenly spaced ones
-// do.
+// do. The planners hand over their simulation of each step, so the raw chain is not simulated
+// again; the bundle planners answer a free straight command with it (found_by direct), a blocked
+// one by searching.
 #include <gtest/gtest.h>
 
 #include <memory>
@@ -58,7 +60,7 @@ const PathCase& long_path() {
     SimulatorWorkspace ws(f.sim);
     PathCase out;
     out.problem = problem_to(f.a, f.c);
-    out.result = plan(context, ws, "boe", {}, out.problem);
+    out.result = plan(context, ws, "boe", searching("boe"), out.problem);
     return out;
   }();
   return c;
@@ -322,6 +324,122 @@ TEST(Execution, BlendThatWouldCollideKeepsItsStop) {
   EXPECT_EQ(checker_verdict(*o.sim, e.trajectory),
             "");  // the kept stop too: at rest within every rate limit
   expect_at_rest_ends(*o.sim, e, c.problem);
+}
+
+// The planners hand over their simulation of every step: the post-processing does not simulate
+// the raw chain again (issue 27), and gives exactly what it gave when it did.
+TEST(Execution, TheRawChainIsNotSimulatedAgain) {
+  const Fixture& f = fixture();
+  PathCase c = long_path();
+  ASSERT_TRUE(c.result.success) << c.result.failure;
+  long handed_ticks = 0;
+  for (const PathStep& s : c.result.best_path) {
+    ASSERT_TRUE(s.outcome) << "a step without the planner's simulation";
+    handed_ticks += s.outcome->ticks;
+  }
+  PathCase bare = c;  // the same path without the planner's simulations
+  for (PathStep& s : bare.result.best_path) s.outcome.reset();
+  for (bool shortcut : {false, true}) {
+    SCOPED_TRACE(shortcut ? "shortcuts and blends" : "blends");
+    const ExecutableTrajectory handed = execute(f.sim, c, options(shortcut, true));
+    const ExecutableTrajectory again = execute(f.sim, bare, options(shortcut, true));
+    EXPECT_EQ(again.stats.simulations - handed.stats.simulations,
+              static_cast<int>(c.result.best_path.size()));
+    EXPECT_EQ(again.stats.simulated_ticks - handed.stats.simulated_ticks, handed_ticks);
+    EXPECT_EQ(handed.trajectory.q, again.trajectory.q);
+    EXPECT_EQ(handed.trajectory.dq, again.trajectory.dq);
+    EXPECT_EQ(handed.stats.raw_cost, again.stats.raw_cost);
+    EXPECT_EQ(handed.stats.raw_duration, again.stats.raw_duration);
+    EXPECT_EQ(resimulate_segments(f.sim, handed, c.problem.start), "");
+  }
+}
+
+// The straight command a -> b, free in the fixture's scene.
+PathStep free_straight_step(const PlanningProblem& p) {
+  const Fixture& f = fixture();
+  SimulatorWorkspace ws(f.sim);
+  const std::optional<PathStep> straight = direct_step(f.sim, ws, options(true, true).limits, p);
+  if (!straight || !solves(f.sim, ws, *straight, p.goal)) return {};
+  return *straight;
+}
+
+// A ball at the hand somewhere along the straight motion, clear of the start and the goal.
+bool block_straight_motion(const PlanningProblem& p, const PathStep& straight, Obstructed& out) {
+  const Fixture& f = fixture();
+  const int n = f.robot.dof;
+  const size_t rows = straight.outcome_rows.size() / (4 * n);
+  for (double at : {0.5, 0.4, 0.6, 0.3, 0.7}) {
+    for (double radius : {0.03, 0.02, 0.01}) {
+      RobotData data(f.robot);
+      const size_t k = static_cast<size_t>(at * rows);
+      forward_kinematics(f.robot, data,
+                         Eigen::Map<const Eigen::VectorXd>(&straight.outcome_rows[k * 4 * n], n));
+      out.env = f.env;
+      Obstacle ball;
+      ball.name = "on-the-straight-line";
+      ball.shape.type = ShapeType::Sphere;
+      ball.shape.radius = radius;
+      ball.pose.p = link_pose(f.robot, data, f.robot.tip_link()).p;
+      out.env.obstacles.push_back(ball);
+      out.collision = std::make_unique<CollisionModel>(build_collision_model(f.robot, out.env));
+      out.sim = std::make_unique<Simulator>(f.robot, *out.collision, f.sim.options);
+      SimulatorWorkspace ws(*out.sim);
+      if (check_state(*out.sim, ws, p.start) == RolloutStatus::Valid &&
+          check_state(*out.sim, ws, p.goal.q) == RolloutStatus::Valid)
+        return true;
+    }
+  }
+  return false;
+}
+
+// The bundle planners try the straight command first: where it is free it is the answer (one
+// simulation, no bundle edge) and the post-processing simulates nothing.
+TEST(Execution, AFreeStraightCommandIsTheAnswer) {
+  const Fixture& f = fixture();
+  const PlanningProblem p = problem_to(f.a, f.b);
+  ASSERT_TRUE(free_straight_step(p).outcome) << "a -> b is not free";
+  SimulatorWorkspace ws(f.sim);
+  for (const std::string planner : {"boe", "lazyboe", "lazysp"}) {
+    SCOPED_TRACE(planner);
+    const PlanResult r = plan(bundle_context(f.sim, f.view, f.index), ws, planner, {}, p);
+    ASSERT_TRUE(r.success) << r.failure;
+    EXPECT_EQ(r.found_by, "direct");
+    EXPECT_EQ(r.counters.simulations, 1u);
+    ASSERT_EQ(r.best_path.size(), 1u);
+    EXPECT_EQ(r.best_path[0].bundle_edge, -1);
+    const ExecutableTrajectory e =
+        make_executable(f.sim, ws, p.start, r.best_path, p.goal, options(true, true), 1);
+    EXPECT_EQ(e.stats.simulations, 0);
+    EXPECT_EQ(e.stats.simulated_ticks, 0);
+    EXPECT_EQ(resimulate_segments(f.sim, e, p.start), "");
+    EXPECT_EQ(checker_verdict(f.sim, e.trajectory), "");
+    expect_at_rest_ends(f.sim, e, p);
+  }
+}
+
+// Where an obstacle blocks the straight command, they search.
+TEST(Execution, ABlockedStraightCommandIsNotTheAnswer) {
+  const Fixture& f = fixture();
+  const PlanningProblem p = problem_to(f.a, f.b);
+  const PathStep straight = free_straight_step(p);
+  ASSERT_TRUE(straight.outcome) << "a -> b is not free";
+  Obstructed o;
+  ASSERT_TRUE(block_straight_motion(p, straight, o))
+      << "no ball on the straight motion clears the start and the goal";
+  SimulatorWorkspace ws(*o.sim);
+  const std::optional<PathStep> hit = direct_step(*o.sim, ws, options(true, true).limits, p);
+  ASSERT_TRUE(hit);
+  EXPECT_EQ(hit->outcome->status, RolloutStatus::EnvCollision);
+  for (const std::string planner : {"boe", "lazysp"}) {
+    SCOPED_TRACE(planner);
+    const PlanResult r = plan(bundle_context(*o.sim, f.view, f.index), ws, planner, {}, p);
+    EXPECT_NE(r.found_by, "direct");
+    EXPECT_GT(r.counters.simulations, 1u);
+    if (r.success) {
+      EXPECT_NO_THROW(realize_path(*o.sim, ws, p.start, r.best_path, p.goal, 10));
+      EXPECT_NE(r.best_path[0].bundle_edge, -1);
+    }
+  }
 }
 
 TEST(Execution, DirectCommandIsAStraightLineWithinTheCommandLimits) {

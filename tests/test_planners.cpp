@@ -97,7 +97,7 @@ const std::vector<LibraryRun>& library_runs() {
         r.problem = library_problem(f.a, f.b, easy_budget(r.planner));
         SimulatorWorkspace ws(f.sim);
         try {
-          r.result = plan(context, ws, r.planner, {}, r.problem);
+          r.result = plan(context, ws, r.planner, searching(r.planner), r.problem);
           if (r.result.success) {
             r.trajectory = realize_path(f.sim, ws, r.problem.start, r.result.best_path,
                                         r.problem.goal, kSampleEvery);
@@ -177,7 +177,7 @@ TEST_P(EveryRegisteredPlanner, SolvesAnEasyProblemWithAValidPath) {
   const PlanningContext context = bundle_context(f.sim, f.view, f.index);
   PlanningProblem problem = library_problem(f.a, f.b, 5);
   problem.termination.stop_at_first = true;
-  const std::unique_ptr<Planner> planner = make_planner(name, {});
+  const std::unique_ptr<Planner> planner = make_planner(name, searching(name));
   planner->setup(context);
   SimulatorWorkspace ws(f.sim);
   const PlanResult r = planner->solve(problem, ws);
@@ -312,9 +312,9 @@ TEST(Planners, ARolloutPoolChangesNothingButWhoSimulates) {
     p.termination.stop_at_first = true;
     p.seed = 7;
     SimulatorWorkspace ws(f.sim);
-    const PlanResult alone = plan(context, ws, planner, {}, p);
+    const PlanResult alone = plan(context, ws, planner, searching(planner), p);
     RolloutPool pool(f.sim, 3);
-    const PlanResult pooled = plan(context, ws, planner, {}, p, &pool);
+    const PlanResult pooled = plan(context, ws, planner, searching(planner), p, &pool);
     ASSERT_TRUE(alone.success) << alone.failure;
     EXPECT_GT(pool.rollouts(), 0u) << "the search did not use the pool";
     // Unused rollouts are only those of the last wave, when the search stops.
@@ -350,17 +350,17 @@ TEST(Planners, LazyBoEWithTransferSolvesWithValidPaths) {
     PlanningProblem p = library_problem(f.a, *goal, 5);
     p.termination.stop_at_first = true;
     SimulatorWorkspace ws(f.sim);
-    const PlanResult r = plan(context, ws, "lazyboe", transfer, p);
+    const PlanResult r = plan(context, ws, "lazyboe", searching("lazyboe", transfer), p);
     ASSERT_TRUE(r.success) << r.failure;
     EXPECT_GT(r.counters.lazy_edges, 0u);
     const Trajectory t = realize_path(f.sim, ws, p.start, r.best_path, p.goal, kSampleEvery);
     EXPECT_EQ(validate(f, t, f.a, *goal, kTolerance, "lazyboe"), "");
     RolloutPool pool(f.sim, 3);
-    const PlanResult again = plan(context, ws, "lazyboe", transfer, p, &pool);
+    const PlanResult again = plan(context, ws, "lazyboe", searching("lazyboe", transfer), p, &pool);
     EXPECT_EQ(again.best_cost, r.best_cost);
     EXPECT_EQ(again.counters.simulations, r.counters.simulations);
     EXPECT_EQ(again.counters.lazy_edges, r.counters.lazy_edges);
-    const PlanResult stored = plan(context, ws, "lazyboe", {}, p);
+    const PlanResult stored = plan(context, ws, "lazyboe", searching("lazyboe"), p);
     ASSERT_TRUE(stored.success) << stored.failure;
     simulations[0] += stored.counters.simulations;
     simulations[1] += r.counters.simulations;
@@ -383,12 +383,14 @@ TEST(Planners, LazyBoEWithTransferRefusesABundleWithoutTransferStatistics) {
   const PlanningContext context = bundle_context(f.sim, view, index);
   SimulatorWorkspace ws(f.sim);
   try {
-    plan(context, ws, "lazyboe", {{"lazy_model", 1}}, library_problem(f.a, f.b, 1));
+    plan(context, ws, "lazyboe", searching("lazyboe", {{"lazy_model", 1}}),
+         library_problem(f.a, f.b, 1));
     ADD_FAILURE() << "lazy_model transfer ran without transfer statistics";
   } catch (const Error& e) {
     EXPECT_TRUE(contains(e.what(), "transfer statistics")) << e.what();
   }
-  EXPECT_TRUE(plan(context, ws, "lazyboe", {}, library_problem(f.a, f.b, 1)).success);
+  EXPECT_TRUE(
+      plan(context, ws, "lazyboe", searching("lazyboe"), library_problem(f.a, f.b, 1)).success);
 }
 
 TEST(Planners, LazyBoEOnABundleWithoutPerturbationIsRefused) {
@@ -400,7 +402,7 @@ TEST(Planners, LazyBoEOnABundleWithoutPerturbationIsRefused) {
   const PlanningContext context = bundle_context(f.sim, plain, plain_index);
   SimulatorWorkspace ws(f.sim);
   try {
-    plan(context, ws, "lazyboe", {}, library_problem(f.a, f.b, 1));
+    plan(context, ws, "lazyboe", searching("lazyboe"), library_problem(f.a, f.b, 1));
     ADD_FAILURE() << "lazyboe planned on a bundle without perturbation analysis";
   } catch (const Error& e) {
     EXPECT_TRUE(contains(e.what(), "lazyboe-perturb")) << e.what();
@@ -425,7 +427,7 @@ TEST(Planners, StartOrGoalOutsideTheCoverageFailsWithAReason) {
       SCOPED_TRACE(planner + std::string(start_is_far ? ", far start" : ", far goal"));
       const auto t0 = Clock::now();
       const PlanResult r =
-          plan(context, ws, planner, {},
+          plan(context, ws, planner, searching(planner),
                library_problem(start_is_far ? far_start : f.a, start_is_far ? f.b : far_goal, 5));
       const double seconds = std::chrono::duration<double>(Clock::now() - t0).count();
       EXPECT_FALSE(r.success);
@@ -479,7 +481,7 @@ TEST(Planners, ALazyChainWithoutProgressEnds) {
   goal[n - 1] += 0.5;  // beyond the tolerance, within theta + tolerance of the stored end
   PlanningProblem problem = library_problem(start, goal, 0.5);
   SimulatorWorkspace ws(f.sim);
-  const PlanResult r = plan(context, ws, "lazyboe", {}, problem);
+  const PlanResult r = plan(context, ws, "lazyboe", searching("lazyboe"), problem);
   EXPECT_GT(r.counters.lazy_edges, 0u);
   EXPECT_LE(r.counters.lazy_edges, r.counters.simulations + 2)
       << "lazy edges " << r.counters.lazy_edges << ", simulations " << r.counters.simulations
@@ -559,7 +561,7 @@ TEST(LazySp, ReturnsFullyRevalidatedPathsOfSimulatedEdges) {
       SCOPED_TRACE("problem " + std::to_string(k) + (first ? ", first solution" : ", anytime"));
       PlanningProblem p = library_problem(problems[k].first, problems[k].second, first ? 10 : 0.3);
       p.termination.stop_at_first = first;
-      const PlanResult r = plan(context, ws, "lazysp", {}, p);
+      const PlanResult r = plan(context, ws, "lazysp", searching("lazysp"), p);
       ASSERT_TRUE(r.success) << r.failure;
       EXPECT_GT(r.counters.lazy_edges, 0u);  // predicted states, never simulated
       EXPECT_GE(r.counters.simulations, r.best_path.size());
@@ -593,8 +595,10 @@ TEST(LazySp, TheEdgePenaltyFavoursCandidatesOfFewerEdges) {
     ++problems;
     PlanningProblem p = library_problem(from, to, 10);
     p.termination.stop_at_first = true;
-    const PlanResult without = plan(context, ws, "lazysp", {{"edge_penalty", 0.0}}, p);
-    const PlanResult with = plan(context, ws, "lazysp", {{"edge_penalty", 1.0}}, p);
+    const PlanResult without =
+        plan(context, ws, "lazysp", searching("lazysp", {{"edge_penalty", 0.0}}), p);
+    const PlanResult with =
+        plan(context, ws, "lazysp", searching("lazysp", {{"edge_penalty", 1.0}}), p);
     ASSERT_TRUE(without.success && with.success);
     edges_without += without.best_path.size();
     edges_with += with.best_path.size();
@@ -613,10 +617,10 @@ TEST(LazySp, IdenticalResultsForAFixedSeedWithOrWithoutAPool) {
   p.termination.stop_at_first = true;
   p.seed = 3;
   SimulatorWorkspace ws(f.sim);
-  const PlanResult first = plan(context, ws, "lazysp", {}, p);
-  const PlanResult again = plan(context, ws, "lazysp", {}, p);
+  const PlanResult first = plan(context, ws, "lazysp", searching("lazysp"), p);
+  const PlanResult again = plan(context, ws, "lazysp", searching("lazysp"), p);
   RolloutPool pool(f.sim, 3);
-  const PlanResult pooled = plan(context, ws, "lazysp", {}, p, &pool);
+  const PlanResult pooled = plan(context, ws, "lazysp", searching("lazysp"), p, &pool);
   ASSERT_TRUE(first.success) << first.failure;
   for (const PlanResult* r : {&again, &pooled}) {
     EXPECT_EQ(r->success, first.success);
@@ -649,12 +653,12 @@ TEST(LazySp, AGoalBeyondTheBundlesCoverageIsSolvedByTheGrowth) {
   SimulatorWorkspace ws(f.sim);
   PlanningProblem p = library_problem(f.b, goal, 20);
   p.termination.stop_at_first = true;
-  const PlanResult boe = plan(context, ws, "boe", {}, p);
+  const PlanResult boe = plan(context, ws, "boe", searching("boe"), p);
   EXPECT_FALSE(boe.success);
   EXPECT_TRUE(contains(boe.failure, "goal")) << boe.failure;
-  EXPECT_EQ(plan(scanning, ws, "boe", {}, p).failure, boe.failure);
+  EXPECT_EQ(plan(scanning, ws, "boe", searching("boe"), p).failure, boe.failure);
 
-  const PlanResult r = plan(context, ws, "lazysp", {}, p);
+  const PlanResult r = plan(context, ws, "lazysp", searching("lazysp"), p);
   ASSERT_TRUE(r.success) << r.failure;
   EXPECT_EQ(r.found_by, "growth");
   EXPECT_EQ(r.best_path.back().bundle_edge, -1);  // the last step is a growth command
@@ -671,7 +675,7 @@ TEST(LazySp, ACandidateEdgeThatCollidesIsRepairedAround) {
   PlanningProblem p = library_problem(f.a, f.c, 10);
   p.termination.stop_at_first = true;
   SimulatorWorkspace ws(f.sim);
-  const PlanResult clear = plan(session_context(f, f.sim), ws, "lazysp", {}, p);
+  const PlanResult clear = plan(session_context(f, f.sim), ws, "lazysp", searching("lazysp"), p);
   ASSERT_TRUE(clear.success) << clear.failure;
   const Trajectory t = realize_path(f.sim, ws, p.start, clear.best_path, p.goal, kSampleEvery);
   RobotData data(f.robot);
@@ -690,7 +694,7 @@ TEST(LazySp, ACandidateEdgeThatCollidesIsRepairedAround) {
   ASSERT_EQ(check_state(blocked, bws, p.goal.q), RolloutStatus::Valid);
   EXPECT_THROW(realize_path(blocked, bws, p.start, clear.best_path, p.goal, 0), Error);
 
-  const PlanResult r = plan(session_context(f, blocked), bws, "lazysp", {}, p);
+  const PlanResult r = plan(session_context(f, blocked), bws, "lazysp", searching("lazysp"), p);
   ASSERT_TRUE(r.success) << r.failure;
   EXPECT_EQ(r.found_by, "bundle");
   EXPECT_GT(r.counters.simulations, r.best_path.size()) << "no simulation failed";

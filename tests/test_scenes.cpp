@@ -87,6 +87,8 @@ std::vector<json> run_queries(const std::string& name, const std::vector<json>& 
 // A result without the fields that depend on the wall clock or the line.
 json timeless(json r) {
   r.erase("time_to_first_solution");
+  r.erase("planning_seconds");
+  r.erase("time_to_executable");
   r.erase("line");
   if (r.contains("post_processing")) {
     r["post_processing"].erase("seconds");

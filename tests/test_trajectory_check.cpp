@@ -118,7 +118,7 @@ const std::vector<PlannedPath>& planned_paths() {
       p.goal.tolerance = kTolerance;
       p.termination.budget = 5 * time_scale();  // the sanitizers slow the planners
       p.seed = 1;
-      const PlanResult r = plan(context, ws, "lazysp", {}, p);
+      const PlanResult r = plan(context, ws, "lazysp", searching("lazysp"), p);
       if (!r.success) continue;
       out.push_back({r.best_path, start, realize_path(f.sim, ws, start, r.best_path, p.goal, 1)});
     }

@@ -41,23 +41,6 @@ std::string machine_description() {
   return text;
 }
 
-// The parameters a resumed study must share with the interrupted one.
-nlohmann::json study_parameters(const std::string& bundle, const std::string& planners,
-                                double budget, int repeats, uint64_t seed, int problems,
-                                const std::string& problems_file, double tolerance, bool raw,
-                                int shortcut_attempts) {
-  return {{"bundle", fs::absolute(bundle).string()},
-          {"planners", planners},
-          {"budget", budget},
-          {"repeats", repeats},
-          {"seed", seed},
-          {"problems", problems},
-          {"problems_file", problems_file.empty() ? "" : fs::absolute(problems_file).string()},
-          {"tolerance", tolerance},
-          {"raw", raw},
-          {"shortcut_attempts", shortcut_attempts}};
-}
-
 void write_text(const fs::path& path, const std::string& text) {
   AtomicFile file(path.string());
   file.stream() << text;
@@ -90,9 +73,24 @@ struct BenchOptions {
   double budget = 60, tolerance = 0;
   uint64_t seed = 1;
   bool resume = false, force = false, no_figures = false, no_mmap = false, quiet = false;
-  bool raw = false;
+  bool raw = false, no_direct = false;
   int shortcut_attempts = ExecutionOptions{}.shortcut_attempts;
 };
+
+// The parameters a resumed study must share with the interrupted one.
+nlohmann::json study_parameters(const BenchOptions& o) {
+  return {{"bundle", fs::absolute(o.bundle_path).string()},
+          {"planners", o.planners},
+          {"budget", o.budget},
+          {"repeats", o.repeats},
+          {"seed", o.seed},
+          {"problems", o.problems},
+          {"problems_file", o.problems_file.empty() ? "" : fs::absolute(o.problems_file).string()},
+          {"tolerance", o.tolerance},
+          {"raw", o.raw},
+          {"no_direct", o.no_direct},
+          {"shortcut_attempts", o.shortcut_attempts}};
+}
 
 void add_options(CLI::App& app, BenchOptions& o) {
   app.add_option("--bundle", o.bundle_path, "Bundle file (HDF5) with its perturbation analysis")
@@ -136,6 +134,9 @@ void add_options(CLI::App& app, BenchOptions& o) {
   app.add_flag("--raw", o.raw,
                "Do not post-process returned paths (runs.csv's execution columns are then the "
                "raw chain's)");
+  app.add_flag("--no-direct", o.no_direct,
+               "The bundle planners search every problem (their parameter direct = false): the "
+               "study measures their searches, also on problems one straight command solves");
   app.add_option("--shortcut-attempts", o.shortcut_attempts,
                  "Post-processing budget: direct commands tried per path (0: junction blending "
                  "only)")
@@ -305,9 +306,7 @@ StudyInfo study_info(const BenchOptions& o, const PlanningSession& session,
 int run(const BenchOptions& o, const std::string& command_line) {
   const StudyPaths paths{fs::path(o.out_dir)};
   check_out_dir(o, paths);
-  const nlohmann::json parameters =
-      study_parameters(o.bundle_path, o.planners, o.budget, o.repeats, o.seed, o.problems,
-                       o.problems_file, o.tolerance, o.raw, o.shortcut_attempts);
+  const nlohmann::json parameters = study_parameters(o);
   if (o.resume) check_same_study(paths.study, parameters);  // before anything is loaded
 
   planner_specs(o.planners);  // names checked before the bundle is loaded
@@ -317,6 +316,7 @@ int run(const BenchOptions& o, const std::string& command_line) {
                  session.bundle.size(), session.load_seconds);
   }
   std::vector<PlannerSpec> specs = planner_specs(o.planners);
+  if (o.no_direct) search_only(specs);
   const PlanningContext context = session.context();
   check_planner_specs(context, specs);
   for (const PlannerSpec& s : specs) {

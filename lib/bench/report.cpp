@@ -99,7 +99,7 @@ const std::vector<std::string>& runs_csv_header() {
       "n_solutions", "nodes", "simulations", "lazy_edges", "collision_checks", "budget", "failure",
       // The returned trajectory's execution and the raw chain's (lazyboe-bench --raw: the same).
       "duration", "stops", "arc_length", "raw_duration", "raw_stops", "post_seconds", "junctions",
-      "blends_kept", "shortcuts"};
+      "blends_kept", "shortcuts", "found_by"};
   return header;
 }
 
@@ -114,7 +114,7 @@ std::string runs_csv_row(const RunRecord& r, const std::string& problem_id) {
   row << ',' << number(r.duration, "%.3f") << ',' << count(r.stops) << ','
       << number(r.arc_length, "%.6f") << ',' << number(r.raw_duration, "%.3f") << ','
       << count(r.raw_stops) << ',' << number(r.post_seconds, "%.6f") << ',' << count(r.junctions)
-      << ',' << count(r.blends_kept) << ',' << count(r.shortcuts);
+      << ',' << count(r.blends_kept) << ',' << count(r.shortcuts) << ',' << quoted(r.found_by);
   return row.str();
 }
 
@@ -207,6 +207,7 @@ std::vector<RunRecord> read_runs_csv(const std::string& path,
     r.junctions = count(20, "junctions");
     r.blends_kept = count(21, "blends_kept");
     r.shortcuts = count(22, "shortcuts");
+    r.found_by = fields[23];
     runs.push_back(std::move(r));
   }
   return runs;
@@ -232,6 +233,7 @@ struct PlannerStats {
   std::vector<double> duration, raw_duration, stops, raw_stops, arc_length, post_seconds,
       ttfs_with_post;
   long junctions = 0, blends_kept = 0, shortcuts = 0;
+  size_t direct = 0;  // solved by the straight command tried before the search
 };
 
 std::string fixed(double value, int digits) {
@@ -312,12 +314,16 @@ void write_execution(std::ostream& md, std::map<std::string, PlannerStats>& stat
   md << "Over the successful runs: the returned trajectory (post-processed: shortcuts and "
         "junction blending, docs/execution.md; the raw chain itself with --raw) against the "
         "raw edge chain. Stops exclude the start and the end. Post-processing runs after the "
-        "planner's clock has stopped, outside the budget; its time is what it adds to the raw "
-        "chain's re-simulation, which every run has.\n\n";
+        "planner's clock has stopped, outside the budget; our planners hand over their own "
+        "simulation of each step, OMPL's do not (their chain is simulated again). Time to an "
+        "executable trajectory: time to first solution plus post-processing. Direct: runs a "
+        "bundle planner answered with the straight command it tries before searching (none "
+        "with --no-direct).\n\n";
   md << "| planner | median duration (s) | median raw duration (s) | shorter | median stops | "
         "median raw stops | median arc length (rad) | median raw arc length (rad) | blends kept "
-        "| shortcuts | median post-processing (s) | median TTFS + post-processing (s) |\n";
-  md << "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+        "| shortcuts | direct | median post-processing (s) | median time to an executable "
+        "trajectory (s) |\n";
+  md << "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const PlannerSpec& spec : specs) {
     if (!spec.available) continue;
     const PlannerStats& s = stats[spec.name];
@@ -326,7 +332,7 @@ void write_execution(std::ostream& md, std::map<std::string, PlannerStats>& stat
        << fixed(100 * (1 - d / raw), 0) << "% | " << fixed(median_of(s.stops), 1) << " | "
        << fixed(median_of(s.raw_stops), 1) << " | " << fixed(median_of(s.arc_length), 2) << " | "
        << fixed(median_of(s.cost), 2) << " | " << s.blends_kept << " / " << s.junctions << " | "
-       << s.shortcuts << " | " << fixed(median_of(s.post_seconds), 4) << " | "
+       << s.shortcuts << " | " << s.direct << " | " << fixed(median_of(s.post_seconds), 4) << " | "
        << fixed(median_of(s.ttfs_with_post), 4) << " |\n";
   }
 }
@@ -353,6 +359,7 @@ std::map<std::string, PlannerStats> planner_stats(const std::vector<RunRecord>& 
     s.junctions += std::max(0, r.junctions);
     s.blends_kept += std::max(0, r.blends_kept);
     s.shortcuts += std::max(0, r.shortcuts);
+    s.direct += r.found_by == "direct";
   }
   return stats;
 }
@@ -373,8 +380,9 @@ std::string summary_markdown(const StudyInfo& info, const std::vector<PlannerSpe
     md << "- A single straight command (start to goal, rest to rest, within the bundle's command "
           "limits, every check) solves "
        << info.direct << " of " << info.problems
-       << " problems: those need no planning, and the post-processing's first shortcut finds "
-          "them whatever the planner\n";
+       << " problems: those need no planning; the bundle planners answer them with that command "
+          "before searching (unless --no-direct), and the post-processing's first shortcut "
+          "finds them whatever the planner\n";
   md << "- Machine: " << info.machine << "\n";
   md << "- Command: `" << info.command_line << "`\n\n";
   md << "Time to first solution and final cost are over the successful runs; the number of "

@@ -126,10 +126,17 @@ void check_planner_specs(const PlanningContext& context, std::vector<PlannerSpec
   }
 }
 
+void search_only(std::vector<PlannerSpec>& specs) {
+  for (PlannerSpec& s : specs) {
+    const PlannerInfo* info = find_planner(s.planner);
+    if (info && info->parameter("direct")) s.parameters.set("direct", 0);
+  }
+}
+
 namespace {
 
-// The returned trajectory's figures; the raw chain's come from the post-processing's own
-// re-simulation of it (the same simulations as realize_path's, so the same cost to the bit).
+// The returned trajectory's figures; the raw chain's come from the post-processing (the
+// planner's own simulations of it, or its re-simulation: the same cost to the bit).
 void record_trajectory(const PlanAnswer& a, RunRecord& r) {
   r.duration = a.trajectory.duration;
   r.stops = a.trajectory.stops;
@@ -144,7 +151,7 @@ void record_trajectory(const PlanAnswer& a, RunRecord& r) {
   r.best_cost = e.raw_cost;
   r.raw_duration = e.raw_duration;
   r.raw_stops = e.raw_stops;
-  r.post_seconds = e.seconds - e.raw_seconds;
+  r.post_seconds = e.seconds;
   r.junctions = e.junctions;
   r.blends_kept = e.blends_kept;
   r.shortcuts = e.shortcuts;
@@ -185,6 +192,7 @@ RunRecord run_planner(const PlanningContext& context, SimulatorWorkspace& ws,
     return r;
   }
   record_trajectory(a, r);
+  r.found_by = a.result.found_by;
   r.success = true;
   r.time_to_first_solution = a.result.time_to_first_solution;
   return r;

@@ -49,6 +49,9 @@ std::vector<PlannerSpec> planner_specs(const std::string& list);
 // setup refuses it: lazyboe-transfer on a bundle without transfer statistics).
 void check_planner_specs(const PlanningContext& context, std::vector<PlannerSpec>& specs);
 
+// Sets direct = false on every spec whose planner declares it (lazyboe-bench --no-direct).
+void search_only(std::vector<PlannerSpec>& specs);
+
 struct RunRecord {
   std::string planner;
   int problem = 0;  // index into the study's problems
@@ -68,10 +71,11 @@ struct RunRecord {
   double arc_length = std::numeric_limits<double>::quiet_NaN();  // rad
   double raw_duration = std::numeric_limits<double>::quiet_NaN();
   int raw_stops = -1;
-  // Wall time the post-processing adds (beyond the raw chain's re-simulation, which every run
-  // has); not part of the budget.
+  // Wall time of the post-processing (after the planner's clock has stopped; not part of the
+  // budget): time to first solution + post_seconds is the time to an executable trajectory.
   double post_seconds = 0;
   int junctions = -1, blends_kept = -1, shortcuts = -1;
+  std::string found_by;  // PlanResult::found_by ("direct", "bundle", "growth" or empty)
 };
 
 // The seed of a (problem, repeat) run: the same for every planner, different across repeats.

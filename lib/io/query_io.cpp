@@ -193,10 +193,15 @@ nlohmann::json rows_json(const std::vector<JointVector>& rows) {
 }
 
 nlohmann::json execution_json(const ExecutionStats& e) {
-  return {{"raw_steps", e.raw_steps},     {"steps", e.steps},
-          {"shortcuts", e.shortcuts},     {"junctions", e.junctions},
-          {"blends_kept", e.blends_kept}, {"simulations", e.simulations},
-          {"seconds", e.seconds},         {"raw_seconds", e.raw_seconds},
+  return {{"raw_steps", e.raw_steps},
+          {"steps", e.steps},
+          {"shortcuts", e.shortcuts},
+          {"junctions", e.junctions},
+          {"blends_kept", e.blends_kept},
+          {"simulations", e.simulations},
+          {"simulated_ticks", e.simulated_ticks},
+          {"seconds", e.seconds},
+          {"raw_seconds", e.raw_seconds},
           {"fell_back", e.fell_back}};
 }
 
@@ -248,6 +253,8 @@ nlohmann::json result_json(const Query& q, const PlanAnswer& a, const PlanningWo
                    {"collision_checks", r.counters.collision_checks}};
   if (!r.success) j["failure"] = r.failure;
   if (r.success && !r.found_by.empty()) j["found_by"] = r.found_by;
+  j["planning_seconds"] = a.planning_seconds;
+  if (r.success) j["time_to_executable"] = a.seconds;
   j["scene"] = {{"name", world.env.name}, {"hash", world.env.identity}};
   if (r.success) add_trajectory(a, mode, csv_path, j);
   return j;

@@ -29,7 +29,7 @@ struct Step {
   std::vector<double> ticks;
 };
 
-// The raw chain: each step simulated from the previous end, as realize_path does.
+// The raw chain: the planner's path, each step from the previous end, as realize_path has it.
 struct RawChain {
   std::vector<JointVector> states;  // start, then each step's end
   std::vector<double> cost;         // per step
@@ -51,6 +51,17 @@ bool within_limits(const RobotModel& robot, const CommandSampling& limits, int j
          kPeakCurvature * std::abs(dv) / (h * h) <= limits.limit_scale * robot.dddq_max[joint];
 }
 
+RolloutResult simulate_step(Work& w, const JointVectorRef& from, const PathStep& s) {
+  const int n = w.sim.robot.dof;
+  const CommandProfile p{s.knots.data(), static_cast<int>(s.knots.size() / n), n,
+                         s.command_duration};
+  const RolloutResult r = simulate(w.sim, w.ws, from, p);
+  w.stats.count(r);
+  return r;
+}
+
+// The raw chain: the planner's simulation of each step where it handed it over, else each step
+// simulated from the previous end, as realize_path does.
 RawChain simulate_raw(Work& w, const JointVectorRef& start, const std::vector<PathStep>& steps,
                       const Goal& goal) {
   const int n = w.sim.robot.dof;
@@ -58,11 +69,8 @@ RawChain simulate_raw(Work& w, const JointVectorRef& start, const std::vector<Pa
   raw.states.push_back(start);
   for (size_t k = 0; k < steps.size(); ++k) {
     const PathStep& s = steps[k];
-    const CommandProfile p{s.knots.data(), static_cast<int>(s.knots.size() / n), n,
-                           s.command_duration};
-    const RolloutResult r = simulate(w.sim, w.ws, raw.states.back(), p);
-    ++w.stats.simulations;
-    if (!r.valid()) {
+    const RolloutResult r = s.outcome ? *s.outcome : simulate_step(w, raw.states.back(), s);
+    if (!r.valid() || r.qf.size() != n) {
       fail("path",
            "step " + std::to_string(k) + " fails re-validation: " + rollout_status_name(r.status));
     }
@@ -86,6 +94,13 @@ std::vector<Step> raw_steps(const std::vector<PathStep>& steps, const RawChain& 
     out[k].target = raw.states[k + 1];
     out[k].first_raw = out[k].last_raw = static_cast<int>(k);
     out[k].uniform = true;
+    // The last step alone, from the raw chain's state, is simulated with the planners' settle
+    // (final_sim): the planner's own simulation of it is that segment's, when it kept the rows.
+    if (k + 1 == steps.size() && steps[k].outcome && !steps[k].outcome_rows.empty()) {
+      out[k].simulated = true;
+      out[k].result = *steps[k].outcome;
+      out[k].ticks = steps[k].outcome_rows;
+    }
   }
   return out;
 }
@@ -121,7 +136,7 @@ RolloutResult simulate_to_target(Work& w, const JointVectorRef& q0, std::vector<
     const CommandProfile p{knots.data(), static_cast<int>(times.size()), n, times.back(),
                            uniform ? nullptr : times.data()};
     r = simulate(sim, w.ws, q0, p, {nullptr, nullptr, 0, &w.ticks});
-    ++w.stats.simulations;
+    w.stats.count(r);
     if (!r.valid() || round >= w.options.max_corrections) return r;
     const JointVector residual = target - r.qf;
     if (residual.cwiseAbs().maxCoeff() <= w.options.correction_tolerance) return r;
@@ -490,17 +505,32 @@ ExecutableTrajectory make_executable(const Simulator& sim, SimulatorWorkspace& w
   return out;
 }
 
+std::optional<PathStep> direct_step(const Simulator& sim, SimulatorWorkspace& ws,
+                                    const CommandSampling& limits, const PlanningProblem& problem) {
+  const Goal& goal = problem.goal;
+  if (goal.kind != Goal::Kind::Joint) return std::nullopt;
+  std::vector<double> times;
+  PathStep step;
+  if (!direct_command(sim.robot, limits, goal.q - problem.start, sim.dt, times, step.knots))
+    return std::nullopt;
+  // Evenly spaced knots (times[j] = j h), simulated as such: as a path step is.
+  step.command_duration = times.back();
+  const CommandProfile profile{step.knots.data(), static_cast<int>(times.size()), sim.robot.dof,
+                               step.command_duration};
+  step.outcome =
+      simulate(sim, ws, problem.start, profile, {nullptr, nullptr, 0, &step.outcome_rows});
+  return step;
+}
+
+bool solves(const Simulator& sim, SimulatorWorkspace& ws, const PathStep& step, const Goal& goal) {
+  return step.outcome && step.outcome->valid() &&
+         goal.contains(sim.robot, ws.robot, step.outcome->qf);
+}
+
 bool solved_by_direct_command(const Simulator& sim, SimulatorWorkspace& ws,
                               const CommandSampling& limits, const PlanningProblem& problem) {
-  const Goal& goal = problem.goal;
-  if (goal.kind != Goal::Kind::Joint) return false;
-  std::vector<double> times, knots;
-  if (!direct_command(sim.robot, limits, goal.q - problem.start, sim.dt, times, knots))
-    return false;
-  const CommandProfile profile{knots.data(), static_cast<int>(times.size()), sim.robot.dof,
-                               times.back(), times.data()};
-  const RolloutResult r = simulate(sim, ws, problem.start, profile);
-  return r.valid() && goal.contains(sim.robot, ws.robot, r.qf);
+  const std::optional<PathStep> step = direct_step(sim, ws, limits, problem);
+  return step && solves(sim, ws, *step, problem.goal);
 }
 
 }  // namespace lazyboe

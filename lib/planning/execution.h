@@ -1,6 +1,7 @@
 // Post-processing of a returned path into a trajectory a robot can execute as it is (issue 14):
 // a planner's path is a chain of rest-to-rest commands (bundle edges or sampled commands), each
-// simulated with a settle at rest. This stage
+// simulated with a settle at rest; our planners hand over their own simulation of each step
+// (PathStep::outcome), so the raw chain is not simulated again (issue 27). This stage
 //   1. shortcuts: replaces runs of steps by one direct, straight-line command between their
 //      end states when that simulates valid and is shorter (farthest first, within a budget of
 //      attempts);
@@ -18,6 +19,7 @@
 // as it is. Deterministic: no randomness, no wall clock in any decision.
 #pragma once
 
+#include <optional>
 #include <vector>
 
 #include "lazyboe/planning/problem.h"
@@ -54,18 +56,26 @@ struct ExecutionSegment {
 };
 
 struct ExecutionStats {
-  int raw_steps = 0;       // steps of the planner's path
-  int steps = 0;           // after shortcutting
-  int shortcuts = 0;       // runs of raw steps replaced by one direct command
-  int junctions = 0;       // between the steps after shortcutting
-  int blends_kept = 0;     // junctions passed without stopping
-  int stops = 0;           // junctions kept at rest (= junctions - blends_kept)
-  int simulations = 0;     // rollouts simulated by this stage (the raw chain's included)
-  double seconds = 0;      // wall time of this stage (reported, never used in a decision)
-  double raw_seconds = 0;  // of which re-simulating the raw chain (realize_path's work)
+  int raw_steps = 0;    // steps of the planner's path
+  int steps = 0;        // after shortcutting
+  int shortcuts = 0;    // runs of raw steps replaced by one direct command
+  int junctions = 0;    // between the steps after shortcutting
+  int blends_kept = 0;  // junctions passed without stopping
+  int stops = 0;        // junctions kept at rest (= junctions - blends_kept)
+  int simulations =
+      0;  // rollouts simulated by this stage (raw steps the planner did not hand over included)
+  long simulated_ticks = 0;  // control ticks of those rollouts
+  double seconds = 0;        // wall time of this stage (reported, never used in a decision)
+  double raw_seconds =
+      0;  // of which the raw chain (re-simulating steps the planner did not hand over)
   bool fell_back = false;  // the raw chain is returned as it is
   double raw_duration = 0, raw_cost = 0;
   int raw_stops = 0;
+
+  void count(const RolloutResult& r) {
+    ++simulations;
+    simulated_ticks += r.ticks;
+  }
 };
 
 struct ExecutableTrajectory {
@@ -104,9 +114,17 @@ bool direct_command(const RobotModel& robot, const CommandSampling& limits,
                     const JointVectorRef& displacement, double dt, std::vector<double>& times,
                     std::vector<double>& knots);
 
-// Whether one direct command from the problem's start to its joint goal (direct_command within
-// `limits`), simulated with every check, ends at rest inside the goal region: a problem that
-// needs no planning. False for a position goal (no joint target to aim at).
+// The direct command from the problem's start to its joint goal (direct_command within
+// `limits`), simulated with every check from the start with `sim`'s settle: the step with that
+// simulation as its outcome (valid or not) and its per-tick rows. None for a position goal (no
+// joint target to aim at) or a goal at the start.
+std::optional<PathStep> direct_step(const Simulator& sim, SimulatorWorkspace& ws,
+                                    const CommandSampling& limits, const PlanningProblem& problem);
+
+// Whether a step with an outcome ends valid at rest inside the goal region.
+bool solves(const Simulator& sim, SimulatorWorkspace& ws, const PathStep& step, const Goal& goal);
+
+// Whether the direct step solves the problem: a problem that needs no planning.
 bool solved_by_direct_command(const Simulator& sim, SimulatorWorkspace& ws,
                               const CommandSampling& limits, const PlanningProblem& problem);
 

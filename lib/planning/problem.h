@@ -8,7 +8,9 @@
 #include <chrono>
 #include <cstdint>
 #include <limits>
+#include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "lazyboe/sim/simulator.h"
@@ -69,11 +71,22 @@ ProblemIssue find_problem_issue(const Simulator& sim, SimulatorWorkspace& ws,
 // The same, throwing Error("<field>: <what>") for the first issue found.
 void validate_problem(const Simulator& sim, SimulatorWorkspace& ws, const PlanningProblem& problem);
 
-// One step of a path: a command applied from the previous step's end state.
+// One step of a path: a command (evenly spaced knots) applied from the previous step's end state.
 struct PathStep {
-  int64_t bundle_edge = -1;  // the bundle edge whose command this is, or -1 (RRT/SST)
+  PathStep() = default;
+  PathStep(int64_t edge, std::vector<double> command_knots, double duration)
+      : bundle_edge(edge), knots(std::move(command_knots)), command_duration(duration) {}
+
+  int64_t bundle_edge = -1;  // the bundle edge whose command this is, or -1 (RRT/SST, direct)
   std::vector<double> knots;
   double command_duration = 0;
+  // The planner's own valid simulation of this command from the previous step's end state (the
+  // exact start for the first step) with the context's simulator, when it hands it over: the
+  // post-processing takes it as the raw chain's instead of simulating the step again (issue
+  // 27). `outcome_rows`, when not empty: that simulation's per-tick rows (TrajectorySamples::
+  // ticks), so that a last step kept as it is needs no simulation either.
+  std::optional<RolloutResult> outcome;
+  std::vector<double> outcome_rows;
 };
 
 struct PlannerCounters {
@@ -91,8 +104,9 @@ struct PlanResult {
   std::vector<PathStep> best_path;
   PlannerCounters counters;
   std::string failure;  // why there is no solution
-  // Which part of the planner found the best path, for planners with several ("bundle" or
-  // "growth" for lazysp); empty for the others.
+  // Which part of the planner found the best path, for planners with several: "direct" (the
+  // bundle planners' straight command, tried first), "bundle" or "growth" (lazysp's search or
+  // growth); empty for the others.
   std::string found_by;
 };
 

@@ -35,6 +35,10 @@ struct PlanAnswer {
   Trajectory trajectory;     // when result.success: the executable one, or the raw chain
   ExecutionStats execution;  // the post-processing's figures (untouched when raw)
   bool raw = false;          // trajectory is the raw chain
+  // Wall time, s: of planning (the solve with its setup and the problem's checks), and of the
+  // whole request (planning, then the returned trajectory: with stop_at_first, the time to an
+  // executable trajectory).
+  double planning_seconds = 0, seconds = 0;
 };
 
 // The post-processing options of `output` in `context`: the context's command limits.

@@ -7,8 +7,10 @@
 
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <vector>
 
+#include "lazyboe/planning/execution.h"
 #include "lazyboe/planning/planner.h"
 
 namespace lazyboe {
@@ -19,6 +21,28 @@ struct SearchNode {
   int parent = -1;
   double cost = 0;  // arc length from the start (estimated for lazy nodes)
   double h = 0;     // heuristic: distance to the goal
+  // The simulation of the command from the parent, once the node is real (what a returned path
+  // hands the post-processing: PathStep::outcome).
+  double edge_length = 0, edge_duration = 0;
+  int edge_ticks = 0;
+
+  // Makes the node the end of rollout r (valid) from its parent, which costs parent_cost.
+  void reached(const RolloutResult& r, double parent_cost) {
+    q = r.qf;
+    cost = parent_cost + r.path_length;
+    edge_length = r.path_length;
+    edge_duration = r.duration;
+    edge_ticks = r.ticks;
+  }
+  // The rollout that reached it, as far as a returned path needs it.
+  RolloutResult outcome() const {
+    RolloutResult r;
+    r.qf = q;
+    r.path_length = edge_length;
+    r.duration = edge_duration;
+    r.ticks = edge_ticks;
+    return r;
+  }
 };
 
 template <typename Node>
@@ -61,15 +85,21 @@ class SearchState {
 
   // A real node inside the goal region: a solution. `path_to` gives a node's path.
   void solution(int node, const std::function<std::vector<PathStep>(int)>& path_to) {
-    ++result_.n_solutions;
-    if (!result_.success) {
-      result_.success = true;
-      result_.time_to_first_solution = deadline_.elapsed();
-    }
-    if (!(nodes_[node].cost >= result_.best_cost)) {  // also when best_cost is NaN
-      result_.best_cost = nodes_[node].cost;
-      result_.best_path = path_to(node);
-    }
+    offer(nodes_[node].cost, [&] { return path_to(node); });
+  }
+
+  // Direct connection first (issue 27): the straight command from the start to a joint goal
+  // within the context's command limits (direct_step). When it ends valid in the goal region it
+  // is the solve's answer, found_by "direct" (no path is shorter by more than the goal's
+  // tolerance, so the search is not run); true then.
+  bool connect_directly() {
+    std::optional<PathStep> step = direct_step(ctx_.sim, ws_, ctx_.command, problem_);
+    if (!step) return false;
+    count(*step->outcome);
+    if (!solves(ctx_.sim, ws_, *step, problem_.goal)) return false;
+    offer(step->outcome->path_length, [&] { return std::vector<PathStep>{std::move(*step)}; });
+    result_.found_by = "direct";
+    return true;
   }
 
   // The budget has run out, or the caller cancelled the solve.
@@ -79,6 +109,18 @@ class SearchState {
   }
 
  private:
+  void offer(double cost, const std::function<std::vector<PathStep>()>& path) {
+    ++result_.n_solutions;
+    if (!result_.success) {
+      result_.success = true;
+      result_.time_to_first_solution = deadline_.elapsed();
+    }
+    if (!(cost >= result_.best_cost)) {  // also when best_cost is NaN
+      result_.best_cost = cost;
+      result_.best_path = path();
+    }
+  }
+
   const PlanningContext& ctx_;
   SimulatorWorkspace& ws_;
   const PlanningProblem& problem_;

@@ -93,6 +93,8 @@ class PlanResult:
     planner: str
     success: bool
     time_to_first_solution: Optional[float]
+    planning_seconds: float
+    time_to_executable: Optional[float]
     n_solutions: int
     best_cost: Optional[float]
     counters: dict[str, int]

@@ -334,6 +334,14 @@ void bind_result(py::module_& m) {
           },
           "Seconds to the first solution; None without one.")
       .def_property_readonly(
+          "planning_seconds", [](const PyResult& r) { return r.answer.planning_seconds; },
+          "Wall time of planning, s (the whole budget unless stop_at_first).")
+      .def_property_readonly(
+          "time_to_executable",
+          [opt](const PyResult& r) { return opt(r.result().success, r.answer.seconds); },
+          "Seconds from the start of planning to the returned trajectory (post-processing "
+          "included); None without one.")
+      .def_property_readonly(
           "n_solutions", [](const PyResult& r) { return r.result().n_solutions; },
           "Solutions found within the budget.")
       .def_property_readonly(
@@ -357,7 +365,8 @@ void bind_result(py::module_& m) {
                        ? py::object(py::none())
                        : py::str(r.result().found_by);
           },
-          "Which part of the planner found the best path (lazysp: bundle or growth), or None.")
+          "Which part of the planner found the best path (direct: the straight command the "
+          "bundle planners try first; lazysp: bundle or growth), or None.")
       .def_property_readonly(
           "duration",
           [opt](const PyResult& r) { return opt(r.result().success, r.trajectory().duration); },

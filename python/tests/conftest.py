@@ -29,7 +29,8 @@ def tool(name, *args, **kwargs):
 def without_timings(d):
     """A result line without its wall times (and line number), which no two runs share."""
     d.pop("time_to_first_solution")
-    d.pop("line", None)
+    for timing in ("planning_seconds", "time_to_executable", "line"):
+        d.pop(timing, None)
     for timing in ("seconds", "raw_seconds"):
         d.get("post_processing", {}).pop(timing, None)
     return d

@@ -217,7 +217,8 @@ def test_plan_releases_the_gil(session):
     steps (about 50 ms of CPU) finish before the plan does. Holding the GIL, plan() would let
     the other thread run only before it enters the library (one switch interval, 5 ms)."""
     started, done = threading.Event(), threading.Event()
-    q = query({"planner": "lazyboe", "seed": 5, "stop_at_first": False, "budget": 2.0})
+    q = query({"planner": "lazyboe", "seed": 5, "stop_at_first": False, "budget": 2.0,
+               "direct": False})
 
     def run():
         started.set()
@@ -235,6 +236,23 @@ def test_plan_releases_the_gil(session):
     assert finished_first
 
 
+def test_a_free_straight_command_is_the_answer(session):
+    """START -> GOAL is free in a straight line: the bundle planners answer with that one
+    command (found_by direct, one simulation, no bundle edge), and search with direct=False."""
+    for planner in ("lazyboe", "boe", "lazysp"):
+        r = session.plan(**query({"planner": planner, "seed": 1}))
+        assert r.success and r.found_by == "direct", (planner, r.failure, r.found_by)
+        assert r.counters["simulations"] == 1
+        assert list(r.edges) == [-1]
+        assert r.time_to_executable >= r.time_to_first_solution
+        assert r.to_dict()["post_processing"]["simulations"] == 0  # nothing simulated twice
+        searched = session.plan(**query({"planner": planner, "seed": 1, "direct": False}))
+        assert searched.success and searched.found_by != "direct", planner
+        assert searched.counters["simulations"] > 1
+    rrt = session.plan(**query({"planner": "rrt", "seed": 2}))
+    assert rrt.found_by is None  # RRT has no direct connection of its own
+
+
 def test_planner_needing_what_the_bundle_lacks_raises_runtime_error(unperturbed_path):
     plain = lazyboe.PlanningSession(unperturbed_path)
     with pytest.raises(RuntimeError, match="has no complete perturbation analysis"):
@@ -247,8 +265,8 @@ def test_ctrl_c_stops_a_batch(session):
     """SIGINT while plan_many runs 40 queries of 0.5 s each (10 s on two threads): the batch
     stops after the queries in flight and raises KeyboardInterrupt. (Without the stop, the
     interrupt would only come after the whole batch.)"""
-    qs = [query({"planner": "lazyboe", "seed": k, "stop_at_first": False, "budget": 0.5})
-          for k in range(40)]
+    qs = [query({"planner": "lazyboe", "seed": k, "stop_at_first": False, "budget": 0.5,
+                 "direct": False}) for k in range(40)]
     timer = threading.Timer(0.3, os.kill, (os.getpid(), signal.SIGINT))
     start = time.monotonic()
     timer.start()
@@ -264,7 +282,8 @@ def test_ctrl_c_stops_one_plan(session):
     start = time.monotonic()
     timer.start()
     with pytest.raises(KeyboardInterrupt):
-        session.plan(START, {"q": GOAL, "tolerance": 0.1}, planner="lazyboe", budget=30, seed=1)
+        session.plan(START, {"q": GOAL, "tolerance": 0.1}, planner="lazyboe", budget=30, seed=1,
+                     direct=False)
     timer.join()
     assert time.monotonic() - start < 2
 

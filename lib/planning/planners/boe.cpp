@@ -9,7 +9,7 @@ PlannerInfo boe_planner_info() {
   info.name = "boe";
   info.description = "Bundle of Edges: best-first search simulating every edge within theta";
   info.needs.bundle = true;
-  info.parameters = {theta_parameter()};
+  info.parameters = {theta_parameter(), direct_parameter()};
   info.make = bundle_planner_factory<BundleSearch>(info);
   return info;
 }

@@ -20,6 +20,17 @@ ParameterSpec theta_parameter() {
   return p;
 }
 
+ParameterSpec direct_parameter() {
+  ParameterSpec p;
+  p.name = "direct";
+  p.type = ParameterType::Boolean;
+  p.default_value = 1;
+  p.description =
+      "first simulate the straight command from the start to a joint goal; when it arrives, it "
+      "is the answer (found_by: direct) and no search runs";
+  return p;
+}
+
 double bundle_planner_setup(const PlanningContext& ctx, const ParameterValues& values,
                             const std::string& planner, bool perturbation) {
   if (!ctx.bundle || !ctx.index) fail("planner", planner + " needs an edge bundle");
@@ -52,6 +63,7 @@ BundleSearch::BundleSearch(const BundleSolve& solve)
       bundle_(*solve.context.bundle),
       s_(solve.context, solve.ws, solve.problem),
       theta_(solve.theta),
+      direct_(solve.values.get("direct") != 0),
       ahead_(solve.context.sim, solve.pool) {}
 
 JointVector BundleSearch::edge_end(uint32_t e) const { return row(bundle_.qf(e), bundle_.dof()); }
@@ -61,6 +73,7 @@ double BundleSearch::heuristic_at_end(uint32_t e) {
 }
 
 PlanResult BundleSearch::run() {
+  if (direct_ && s_.connect_directly()) return s_.result();
   BundleNode root;
   root.q = s_.problem().start;
   root.h = s_.heuristic(root.q);
@@ -151,6 +164,7 @@ std::vector<PathStep> BundleSearch::path_to(int node) {
     const CommandProfile c = bundle_.command(s_.node(u).bundle_edge);
     steps.push_back({s_.node(u).bundle_edge,
                      std::vector<double>(c.knots, c.knots + c.n_knots * c.dof), c.duration});
+    steps.back().outcome = s_.node(u).outcome();
   }
   std::reverse(steps.begin(), steps.end());
   return steps;
@@ -181,10 +195,9 @@ void BundleSearch::simulate_edge(int v, uint32_t e, size_t k) {
   const RolloutResult r = rollout_from(v, k);
   if (!r.valid()) return;
   BundleNode c;
-  c.q = r.qf;
+  c.reached(r, s_.node(v).cost);
   c.parent = v;
   c.bundle_edge = e;
-  c.cost = s_.node(v).cost + r.path_length;
   c.h = s_.heuristic(c.q);
   const int id = s_.add(c);
   if (s_.in_goal(c.h)) {

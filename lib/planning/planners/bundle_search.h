@@ -92,6 +92,7 @@ class BundleSearch {
   const BundleView& bundle_;
   SearchState<BundleNode> s_;
   const double theta_;
+  const bool direct_;  // the `direct` parameter
 
  private:
   static uint64_t key(int v, uint32_t e) { return (static_cast<uint64_t>(v) << 32) | e; }
@@ -113,6 +114,8 @@ class BundleSearch {
 
 // theta, as BoE and LazyBoE declare it (default: the bundle's).
 ParameterSpec theta_parameter();
+// `direct`, as every bundle planner declares it: SearchState::connect_directly before the search.
+ParameterSpec direct_parameter();
 
 // Setup shared by the bundle planners: the context must have a bundle and its index (and,
 // with `perturbation`, the perturbation analysis); returns theta (the parameter, else the

@@ -168,9 +168,8 @@ bool LazySearch::realize(int x, long k) {
       return false;
     }
     BundleNode& n = s_.node(u);
-    n.q = r.qf;
+    n.reached(r, s_.node(parent).cost);
     set(lazy_, u, false);
-    n.cost = s_.node(parent).cost + r.path_length;
     n.h = s_.heuristic(n.q);
     if (s_.in_goal(n.h)) {
       found(u);
@@ -198,7 +197,7 @@ PlannerInfo lazyboe_planner_info() {
   model.description =
       "where a lazy edge ends: its stored end (the paper) or the node moved by the edge's "
       "displacement, with P_lazy_prop under transfer";
-  info.parameters = {theta_parameter(), model};
+  info.parameters = {theta_parameter(), direct_parameter(), model};
   info.make = bundle_planner_factory<LazySearch>(info);
   return info;
 }

@@ -36,6 +36,7 @@ constexpr size_t kMarkedSearchLimit = 1000;
 struct Settings {
   double theta, epsilon, resolution, risk_weight, edge_penalty, goal_bias, mark_weight;
   size_t expansion_limit;
+  bool direct;
 };
 
 // A state of the lazy search: predicted (never simulated) or, for a source, a real node's.
@@ -84,7 +85,8 @@ class LazySpSearch {
   bool push(Predicted x, double h);
   bool validate(const std::vector<Predicted>& chain);
   void grow();
-  int add_real(const JointVector& q, int parent, int64_t edge, int command, double cost);
+  // A real node: the end of rollout r from `parent` (-1 and r.qf the start: the root).
+  int add_real(const RolloutResult& r, int parent, int64_t edge, int command);
   void found(int node, const char* by);
   std::vector<PathStep> path_to(int node);
   bool prunable(double g, double h);
@@ -105,7 +107,8 @@ class LazySpSearch {
             v.get("edge_penalty"),
             v.get("goal_bias"),
             v.get("mark_weight"),
-            static_cast<size_t>(v.get("expansion_limit"))};
+            static_cast<size_t>(v.get("expansion_limit")),
+            v.get("direct") != 0};
   }
 
   const PlanningContext& ctx_;
@@ -134,7 +137,10 @@ class LazySpSearch {
 };
 
 PlanResult LazySpSearch::run() {
-  add_real(s_.problem().start, -1, -1, -1, 0);
+  if (set_.direct && s_.connect_directly()) return s_.result();
+  RolloutResult at_start;
+  at_start.qf = s_.problem().start;
+  add_real(at_start, -1, -1, -1);
   // A predicted state x + qf(e) - q0(e), with x within theta of q0(e), lies within theta of
   // qf(e): a joint goal farther than theta + tolerance from every edge end is beyond the lazy
   // search, and only the growth can reach it.
@@ -283,7 +289,7 @@ bool LazySpSearch::validate(const std::vector<Predicted>& chain) {
     tried_.insert(key(r, e));
     const RolloutResult res = s_.simulate_from(s_.node(r).q, bundle_.command(e));
     if (!res.valid()) return false;
-    const int c = add_real(res.qf, r, e, -1, s_.node(r).cost + res.path_length);
+    const int c = add_real(res, r, e, -1);
     if (s_.in_goal(s_.node(c).h)) {  // really in the goal region: a solution
       found(c, "bundle");
       return true;
@@ -308,20 +314,17 @@ void LazySpSearch::grow() {
   growth_work_ += 1;
   if (!res.valid()) return;
   commands_.push_back({-1, std::move(knots), duration});
-  const int c = add_real(res.qf, from, -1, static_cast<int>(commands_.size()) - 1,
-                         s_.node(from).cost + res.path_length);
+  const int c = add_real(res, from, -1, static_cast<int>(commands_.size()) - 1);
   if (s_.in_goal(s_.node(c).h)) found(c, "growth");
 }
 
-int LazySpSearch::add_real(const JointVector& q, int parent, int64_t edge, int command,
-                           double cost) {
+int LazySpSearch::add_real(const RolloutResult& r, int parent, int64_t edge, int command) {
   LazySpNode n;
-  n.q = q;
+  n.reached(r, parent >= 0 ? s_.node(parent).cost : 0.0);
   n.parent = parent;
   n.bundle_edge = edge;
   n.command = command;
-  n.cost = cost;
-  n.h = s_.heuristic(q);
+  n.h = s_.heuristic(n.q);
   return s_.add(std::move(n));
 }
 
@@ -337,11 +340,12 @@ std::vector<PathStep> LazySpSearch::path_to(int node) {
     const LazySpNode& n = s_.node(u);
     if (n.bundle_edge < 0) {
       steps.push_back(commands_[n.command]);
-      continue;
+    } else {
+      const CommandProfile c = bundle_.command(n.bundle_edge);
+      steps.push_back(
+          {n.bundle_edge, std::vector<double>(c.knots, c.knots + c.n_knots * c.dof), c.duration});
     }
-    const CommandProfile c = bundle_.command(n.bundle_edge);
-    steps.push_back(
-        {n.bundle_edge, std::vector<double>(c.knots, c.knots + c.n_knots * c.dof), c.duration});
+    steps.back().outcome = n.outcome();
   }
   std::reverse(steps.begin(), steps.end());
   return steps;
@@ -389,6 +393,7 @@ PlannerInfo lazysp_planner_info() {
   limit.upper = 1e9;
   info.parameters = {
       theta_parameter(),
+      direct_parameter(),
       real_parameter("epsilon", 2.0, 1, false,
                      "heuristic weight of the lazy search (f = g + epsilon h; 1: A*)"),
       real_parameter("resolution", 0.05, 1e-6, false,  // a floor keeps the cell index finite

@@ -43,9 +43,8 @@ PlanResult TreeSearch::run() {
     const RolloutResult r = s_.simulate_from(s_.node(from).q, profile);
     if (!r.valid()) continue;
     TreeNode c;
-    c.q = r.qf;
+    c.reached(r, s_.node(from).cost);
     c.parent = from;
-    c.cost = s_.node(from).cost + r.path_length;
     c.h = s_.heuristic(c.q);
     if (!admit(c)) continue;
     c.command = static_cast<int>(commands_.size());
@@ -87,8 +86,10 @@ int TreeSearch::add(TreeNode c, int from) {
 
 std::vector<PathStep> TreeSearch::path_to(int node) {
   std::vector<PathStep> steps;
-  for (int u = node; s_.node(u).parent >= 0; u = s_.node(u).parent)
+  for (int u = node; s_.node(u).parent >= 0; u = s_.node(u).parent) {
     steps.push_back(commands_[s_.node(u).command]);
+    steps.back().outcome = s_.node(u).outcome();
+  }
   std::reverse(steps.begin(), steps.end());
   return steps;
 }
