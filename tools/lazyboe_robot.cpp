@@ -88,7 +88,7 @@ int cmd_info(const RobotModel& robot, bool as_json) {
     j["control_rate"] = robot.control_rate;
     for (const Joint& jt : robot.joints) {
       j["joints"].push_back({{"name", jt.name},
-                             {"type", jt.type == JointType::Revolute ? "revolute" : "prismatic"},
+                             {"type", joint_type_name(jt)},
                              {"lower", jt.lower},
                              {"upper", jt.upper},
                              {"max_velocity", jt.max_velocity},
@@ -128,8 +128,8 @@ int cmd_info(const RobotModel& robot, bool as_json) {
               "vel", "acc", "jerk", "effort", "d_effort", "friction");
   for (const Joint& j : robot.joints) {
     std::printf("%-14s %-9s %9.4f %9.4f %8.4g %8.4g %8.4g %7.4g %8.4g  %s\n", j.name.c_str(),
-                j.type == JointType::Revolute ? "revolute" : "prismatic", j.lower, j.upper,
-                j.max_velocity, j.max_acceleration, j.max_jerk, j.max_effort, j.max_torque_rate,
+                joint_type_name(j), j.lower, j.upper, j.max_velocity, j.max_acceleration,
+                j.max_jerk, j.max_effort, j.max_torque_rate,
                 friction_json(j.friction).dump().c_str());
   }
   std::printf("\n%-14s %-14s %9s\n", "link", "moved by", "mass(kg)");

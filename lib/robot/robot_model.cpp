@@ -214,11 +214,26 @@ void add_collision_bodies(RobotModel& model, const std::string& urdf_path, const
   }
 }
 
+// A continuous joint's planned range: [lower, upper], rad, finite, lower < upper.
+void read_position_range(const JsonField& field, Joint& joint) {
+  if (!joint.continuous) {
+    field.fail("only a continuous joint takes a position range ('" + joint.name +
+               "' has the URDF's limits)");
+  }
+  const std::vector<JsonField> bounds = field.items();
+  if (bounds.size() != 2) field.fail("expected [lower, upper] in rad");
+  const RealRange any{-1e6, 1e6};
+  joint.lower = bounds[0].number_in(any, " rad");
+  joint.upper = bounds[1].number_in(any, " rad");
+  if (!(joint.lower < joint.upper)) field.fail("expected lower < upper");
+}
+
 void read_config_joints(RobotModel& model, const JsonField& root) {
   std::vector<JsonField> entries = root.at("joints").items();
   std::set<std::string> seen;
   for (const JsonField& entry : entries) {
-    entry.allow_only({"name", "max_acceleration", "max_jerk", "max_torque_rate", "friction"});
+    entry.allow_only(
+        {"name", "max_acceleration", "max_jerk", "max_torque_rate", "friction", "position_range"});
     const std::string name = entry.at("name").string();
     auto it = std::find_if(model.joints.begin(), model.joints.end(),
                            [&](const Joint& j) { return j.name == name; });
@@ -230,6 +245,7 @@ void read_config_joints(RobotModel& model, const JsonField& root) {
     it->max_jerk = entry.at("max_jerk").number_in(kMaxJerk, " rad/s^3");
     it->max_torque_rate = entry.at("max_torque_rate").number_in(kMaxTorqueRate, " N m/s");
     it->friction = read_friction(entry.at("friction"));
+    if (entry.has("position_range")) read_position_range(entry.at("position_range"), *it);
   }
   for (const Joint& j : model.joints) {
     if (!seen.count(j.name)) root.at("joints").fail("no entry for joint '" + j.name + "'");
@@ -332,15 +348,19 @@ std::vector<urdf::LinkConstSharedPtr> find_chain(const JsonField& root,
 Joint joint_from_urdf(const urdf::Joint& uj, const Pose& origin, const std::string& where) {
   Joint j;
   j.name = uj.name;
-  j.type = uj.type == urdf::Joint::REVOLUTE ? JointType::Revolute : JointType::Prismatic;
+  j.type = uj.type == urdf::Joint::PRISMATIC ? JointType::Prismatic : JointType::Revolute;
+  j.continuous = uj.type == urdf::Joint::CONTINUOUS;
   j.origin = origin;
   j.axis = Eigen::Vector3d(uj.axis.x, uj.axis.y, uj.axis.z);
   if (!(j.axis.norm() > 1e-9)) fail(where, "axis must not be zero");
   j.axis.normalize();
   j.axis_is_z = (j.axis - Eigen::Vector3d::UnitZ()).norm() < 1e-15;
-  if (!uj.limits) fail(where, "missing <limit>");
-  j.lower = uj.limits->lower;
-  j.upper = uj.limits->upper;
+  if (!uj.limits) {
+    fail(where, j.continuous ? "missing <limit> (a continuous joint needs its velocity and effort)"
+                             : "missing <limit>");
+  }
+  j.lower = j.continuous ? -kContinuousRange : uj.limits->lower;
+  j.upper = j.continuous ? kContinuousRange : uj.limits->upper;
   j.max_velocity = uj.limits->velocity;
   j.max_effort = uj.limits->effort;
   if (!(std::isfinite(j.lower) && std::isfinite(j.upper) && j.lower < j.upper)) {
@@ -393,7 +413,8 @@ std::vector<urdf::LinkConstSharedPtr> build_bodies(
       const std::string where = upath + ": joint '" + uj.name + "'";
       if (uj.type == urdf::Joint::FIXED) {
         in_body = origin;
-      } else if (uj.type == urdf::Joint::REVOLUTE || uj.type == urdf::Joint::PRISMATIC) {
+      } else if (uj.type == urdf::Joint::REVOLUTE || uj.type == urdf::Joint::PRISMATIC ||
+                 uj.type == urdf::Joint::CONTINUOUS) {
         if (model.dof >= kMaxDof) {
           fail(where, "chain has more than " + std::to_string(kMaxDof) + " moving joints");
         }
@@ -402,7 +423,7 @@ std::vector<urdf::LinkConstSharedPtr> build_bodies(
         body = model.dof++;
         in_body = Pose();
       } else {
-        fail(where, "only revolute, prismatic and fixed joints are supported");
+        fail(where, "only revolute, continuous, prismatic and fixed joints are supported");
       }
     }
     add_link(link, in_body);

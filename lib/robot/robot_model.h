@@ -23,6 +23,9 @@ struct Friction {
   double offset = 0;  // Sigmoid: a/(1+exp(-b c)), precomputed so that tau_f(0) = 0
 };
 
+// The default position range of a continuous joint, rad: [-2 pi, 2 pi].
+constexpr double kContinuousRange = 6.283185307179586;
+
 struct Joint {
   std::string name;
   JointType type = JointType::Revolute;
@@ -30,6 +33,9 @@ struct Joint {
   Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();  // unit, in the joint (= child body) frame
   bool axis_is_z = true;                            // the common case, with a cheaper rotation
   double lower = 0, upper = 0;                      // position limits (rad or m)
+  // A URDF `continuous` joint: a revolute joint planned within lower..upper, the config's
+  // position_range (default kContinuousRange); no wrap-around (q and q + 2 pi are two states).
+  bool continuous = false;
   double max_velocity = 0, max_acceleration = 0, max_jerk = 0;
   double max_effort = 0, max_torque_rate = 0;
   Friction friction;
@@ -41,6 +47,12 @@ struct BodyInertia {
   Eigen::Vector3d com = Eigen::Vector3d::Zero();
   Eigen::Matrix3d inertia_com = Eigen::Matrix3d::Zero();  // about the centre of mass
 };
+
+// "revolute", "continuous" or "prismatic", as the URDF says.
+inline const char* joint_type_name(const Joint& j) {
+  if (j.type == JointType::Prismatic) return "prismatic";
+  return j.continuous ? "continuous" : "revolute";
+}
 
 // Adds a rigid body (mass, centre of mass, inertia about it; all in `into`'s frame) to `into`.
 void merge_inertia(BodyInertia& into, double mass, const Eigen::Vector3d& com,
