@@ -22,7 +22,7 @@ TABLE = {"x": (0.35, 0.95), "y": (-0.6, 0.6), "top": 0.20}
 def table_objects():
     """The bundled table.json's floor, top and legs."""
     objects = [{"name": "floor", "type": "box", "size": [2.0, 2.0, 0.02], "position": [0, 0, -0.01],
-                "allowed_links": ["panda_link0", "panda_link1"]},
+                "allowed_links": ["@base"]},
                {"name": "table_top", "type": "box", "size": [0.6, 1.2, 0.04], "position": [0.65, 0, 0.18]}]
     for i, (x, y) in enumerate([(0.375, 0.575), (0.375, -0.575), (0.925, 0.575), (0.925, -0.575)]):
         objects.append({"name": f"table_leg_{i}", "type": "cylinder", "radius": 0.025, "length": 0.16,

@@ -3,6 +3,7 @@
 // exact distances on many random configurations.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
 
 #include "lazyboe/collision/allowed_pairs.h"
@@ -113,6 +114,24 @@ TEST(Collision, FloorIsAllowedOnlyForTheBaseLinks) {
   EXPECT_FALSE(c.report(q_of({0, 0, 0, -0.1, 0, 0.1, 0})).any());
 }
 
+// "@base" (what the bundled environments say) is the base and the first moving body: for the
+// Panda exactly link0 and link1, the same pairs as naming them; for a chain with links fixed to
+// its base, those too.
+TEST(Collision, AtBaseIsTheBaseAndTheFirstMovingBody) {
+  const RobotModel& robot = test::panda();
+  const Environment named = env_file("empty");
+  ASSERT_EQ(named.obstacles[0].allowed_links,
+            (std::vector<std::string>{"panda_link0", "panda_link1"}));
+  Environment at_base = named;
+  at_base.obstacles[0].allowed_links = {"@base"};
+  EXPECT_EQ(build_collision_model(robot, at_base).env_pairs,
+            build_collision_model(robot, named).env_pairs);
+  std::vector<int> allowed = allowed_links_of(robot, at_base.obstacles[0], "empty.json");
+  std::sort(allowed.begin(), allowed.end());
+  EXPECT_EQ(allowed,
+            (std::vector<int>{robot.link_index("panda_link0"), robot.link_index("panda_link1")}));
+}
+
 // A small sphere placed at a chosen distance d from the link7 capsule's surface: it collides
 // exactly when d is below the margin, and the reported distance is d.
 TEST(Collision, NearTouchingRespectsTheMargin) {
@@ -187,6 +206,7 @@ TEST(Collision, UnknownAllowedLinkInEnvironmentIsAnError) {
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("custom.json"), std::string::npos);
     EXPECT_NE(std::string(e.what()).find("no_such_link"), std::string::npos);
+    EXPECT_NE(std::string(e.what()).find("@base"), std::string::npos) << "names the way out";
   }
 }
 

@@ -255,22 +255,34 @@ CollisionModel build_collision_model(const RobotModel& robot, const Environment&
     }
   }
   for (size_t o = 0; o < env.obstacles.size(); ++o) {
-    std::vector<int> allowed;
-    for (const std::string& name : env.obstacles[o].allowed_links) {
-      const int link = robot.link_index(name);
-      if (link < 0) {
-        fail(env.origin.empty() ? env.path : env.origin,
-             "object '" + env.obstacles[o].name + "': allowed link '" + name +
-                 "' is not a link of robot '" + robot.name + "'");
-      }
-      allowed.push_back(link);
-    }
+    const std::vector<int> allowed =
+        allowed_links_of(robot, env.obstacles[o], env.origin.empty() ? env.path : env.origin);
     for (int a = 0; a < n; ++a) {
       if (std::find(allowed.begin(), allowed.end(), model.robot[a].link) != allowed.end()) continue;
       model.env_pairs.emplace_back(a, static_cast<int>(o));
     }
   }
   return model;
+}
+
+std::vector<int> allowed_links_of(const RobotModel& robot, const Obstacle& obstacle,
+                                  const std::string& where) {
+  std::vector<int> allowed;
+  for (const std::string& name : obstacle.allowed_links) {
+    if (name == kBaseLinks) {
+      for (size_t l = 0; l < robot.links.size(); ++l)
+        if (robot.links[l].body <= 0) allowed.push_back(static_cast<int>(l));
+      continue;
+    }
+    const int link = robot.link_index(name);
+    if (link < 0) {
+      fail(where, "object '" + obstacle.name + "': allowed link '" + name +
+                      "' is not a link of robot '" + robot.name + "' (" + kBaseLinks +
+                      " names its base and first link for any robot)");
+    }
+    allowed.push_back(link);
+  }
+  return allowed;
 }
 
 CollisionData::CollisionData(const CollisionModel& model)

@@ -53,6 +53,18 @@ struct CollisionOptions {
   bool ignore_allowed_pairs = false;  // test every pair of links on different bodies
 };
 
+// The name that stands for the robot's base in an obstacle's allowed_links: every link fixed to
+// the base (the chain's root body) and every link of the first moving body, which stands on the
+// base (the Panda's link1 capsule reaches down to it), whatever the robot calls them, so that
+// one environment serves any robot (a floor the base stands on).
+inline const char* const kBaseLinks = "@base";
+
+// The links an obstacle lets touch it: each link it names, and for "@base" the links of the
+// base and of the first moving body. Throws Error("<where>: object '<name>': allowed link 'x' is
+// not a link of robot 'r'") for a name the robot lacks.
+std::vector<int> allowed_links_of(const RobotModel& robot, const Obstacle& obstacle,
+                                  const std::string& where);
+
 // Throws Error when the environment names a link the robot does not have.
 CollisionModel build_collision_model(const RobotModel& robot, const Environment& env,
                                      const CollisionOptions& options = {});

@@ -2,6 +2,7 @@
 // obstacle occupies, then the edges listed for them.
 #include <octomap/OcTree.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
@@ -79,29 +80,37 @@ void octree_cells(const WorkspaceGrid& grid, const Obstacle& o, F&& f) {
 
 // The indexed links the obstacle does not allow, one bit each.
 uint32_t links_blocked_by(const WorkspaceIndex& index, const RobotModel& robot, const Obstacle& o) {
+  const std::vector<int> allowed = allowed_links_of(robot, o, "scene");
   uint32_t mask = 0;
   for (size_t l = 0; l < index.links().size(); ++l) {
-    const std::string& name = robot.links[index.links()[l]].name;
-    bool allowed = false;
-    for (const std::string& a : o.allowed_links) allowed = allowed || a == name;
-    if (!allowed) mask |= uint32_t{1} << l;
+    if (std::find(allowed.begin(), allowed.end(), index.links()[l]) == allowed.end())
+      mask |= uint32_t{1} << l;
   }
   return mask;
 }
 
+// The links an obstacle lets touch it, sorted (named or through "@base": the same set).
+std::vector<int> allowed_set(const RobotModel& robot, const Obstacle& o) {
+  std::vector<int> links = allowed_links_of(robot, o, "scene");
+  std::sort(links.begin(), links.end());
+  links.erase(std::unique(links.begin(), links.end()), links.end());
+  return links;
+}
+
 // The same primitive at the same pose, touchable by the same links (meshes and octrees are
 // never taken for known: their content is in files).
-bool same_primitive(const Obstacle& a, const Obstacle& b) {
+bool same_primitive(const RobotModel& robot, const Obstacle& a, const Obstacle& b) {
   const Shape &s = a.shape, &t = b.shape;
   return a.type == ObstacleType::Primitive && b.type == ObstacleType::Primitive &&
          s.type == t.type && s.radius == t.radius && s.length == t.length && s.size == t.size &&
-         a.pose.R == b.pose.R && a.pose.p == b.pose.p && a.allowed_links == b.allowed_links;
+         a.pose.R == b.pose.R && a.pose.p == b.pose.p &&
+         allowed_set(robot, a) == allowed_set(robot, b);
 }
 
-bool is_known(const Obstacle& o, const Environment* known) {
+bool is_known(const RobotModel& robot, const Obstacle& o, const Environment* known) {
   if (!known) return false;
   for (const Obstacle& k : known->obstacles)
-    if (same_primitive(o, k)) return true;
+    if (same_primitive(robot, o, k)) return true;
   return false;
 }
 
@@ -116,7 +125,7 @@ EdgeMarks mark_edges(const WorkspaceIndex& index, const RobotModel& robot, const
   std::vector<uint32_t> done(grid.cells(), 0);  // links already marked per cell
   for (size_t i = 0; i < env.obstacles.size(); ++i) {
     const Obstacle& o = env.obstacles[i];
-    const uint32_t want = is_known(o, known) ? 0 : links_blocked_by(index, robot, o);
+    const uint32_t want = is_known(robot, o, known) ? 0 : links_blocked_by(index, robot, o);
     const auto visit = [&](size_t cell) {
       ++m.occupied_cells;
       uint32_t todo = want & ~done[cell];
