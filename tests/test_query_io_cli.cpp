@@ -503,11 +503,39 @@ TEST(QueryCli, StartOrGoalOutsideTheCoverageFailsWithAReason) {
     const std::string failure = r["failure"];
     EXPECT_TRUE(contains(failure, "theta") && contains(failure, "bundle")) << failure;
     EXPECT_FALSE(contains(failure, "time budget")) << failure;
+    EXPECT_TRUE(contains(failure, "try lazysp")) << "says what to do: " << failure;
   }
   std::cout << "[ reason  ] far start: "
             << (t.results.empty() ? "" : t.results[0].value("failure", "")) << "\n"
             << "[ reason  ] far goal:  "
             << (t.results.size() < 2 ? "" : t.results[1].value("failure", "")) << "\n";
+}
+
+// The summary on stderr counts what was solved and never rounds a failure up to 100%.
+TEST(QueryCli, TheSummaryCountsTheSolvedQueries) {
+  const Fixture& f = fixture();
+  const JointVector far_start = far_start_state(f);
+  ASSERT_EQ(far_start.size(), 7) << "no collision-free state far from the bundle's starts";
+  const ToolRun t =
+      run_batch("summary",
+                {query("ok-1", f.a, f.b, "boe", 5, true), query("ok-2", f.b, f.a, "boe", 5, true),
+                 query("far", far_start, f.b, "boe", 3, false)},
+                {});
+  ASSERT_EQ(t.r.exit_code, 0) << describe(t.r);
+  EXPECT_TRUE(contains(t.r.err, "solved")) << t.r.err;
+  std::istringstream lines(t.r.err);
+  bool found = false;
+  for (std::string line; std::getline(lines, line);) {
+    std::istringstream row(line);
+    std::string planner, percent;
+    size_t queries = 0, solved = 0;
+    if (!(row >> planner >> queries >> solved >> percent) || planner != "boe") continue;
+    found = true;
+    EXPECT_EQ(queries, 3u) << line;
+    EXPECT_EQ(solved, 2u) << line;
+    EXPECT_EQ(percent, "66.6%") << line;  // rounded down
+  }
+  EXPECT_TRUE(found) << t.r.err;
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 #include <omp.h>
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -235,8 +236,8 @@ void print_summary(const std::vector<Outcome>& outcomes) {
     else
       by_planner[o.planner].push_back(&o);
   }
-  std::fprintf(stderr, "%-11s %7s %8s %14s %14s %10s\n", "planner", "queries", "success",
-               "median TTFS s", "mean TTFS s", "mean cost");
+  std::fprintf(stderr, "%-11s %7s %7s %8s %14s %14s %10s\n", "planner", "queries", "solved",
+               "success", "median TTFS s", "mean TTFS s", "mean cost");
   for (const auto& [name, list] : by_planner) {
     std::vector<double> ttfs, cost;
     for (const Outcome* o : list) {
@@ -245,8 +246,10 @@ void print_summary(const std::vector<Outcome>& outcomes) {
       cost.push_back(o->cost);
     }
     const Quantiles qt = quantiles(ttfs), qc = quantiles(cost);
-    std::fprintf(stderr, "%-11s %7zu %7.0f%% %14.4f %14.4f %10.3f\n", name.c_str(), list.size(),
-                 100.0 * ttfs.size() / list.size(), qt.median, qt.mean, qc.mean);
+    // One decimal, rounded down: 2999 of 3000 is 99.9%, never 100%.
+    const double percent = std::floor(1000.0 * ttfs.size() / list.size()) / 10;
+    std::fprintf(stderr, "%-11s %7zu %7zu %7.1f%% %14.4f %14.4f %10.3f\n", name.c_str(),
+                 list.size(), ttfs.size(), percent, qt.median, qt.mean, qc.mean);
   }
   if (errors) std::fprintf(stderr, "%zu queries had errors (see their \"error\" field)\n", errors);
   std::fprintf(stderr, "resident memory %.0f MiB\n", resident_memory_mib());

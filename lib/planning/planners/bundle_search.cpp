@@ -101,7 +101,9 @@ bool BundleSearch::covered(Neighbours& neighbours) {
   ctx_.index->within(s_.problem().start.data(), theta_, neighbours);
   if (neighbours.empty()) {
     s_.result().failure = "no bundle edge starts within theta = " + std::to_string(theta_) +
-                          " rad of the start: it is outside the bundle's coverage";
+                          " rad of the start: it is outside the bundle's coverage (try lazysp, "
+                          "whose growth leaves the bundle; a larger theta; or a bundle whose "
+                          "--region holds the start: lazyboe-build --inspect shows its region)";
     return false;
   }
   const Goal& goal = s_.problem().goal;
@@ -109,7 +111,8 @@ bool BundleSearch::covered(Neighbours& neighbours) {
   const double reach = theta_ + goal.tolerance;
   if (edge_ends_near(ctx_, goal.q, reach, neighbours)) return true;
   s_.result().failure = "no bundle edge ends within theta + tolerance = " + std::to_string(reach) +
-                        " rad of the goal: it is outside the bundle's coverage";
+                        " rad of the goal: it is outside the bundle's coverage (try lazysp, a "
+                        "larger theta or tolerance, or a bundle whose --region holds the goal)";
   return false;
 }
 
