@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <filesystem>
 #include <random>
 
 #include "lazyboe/collision/allowed_pairs.h"
@@ -207,6 +208,27 @@ TEST(Collision, UnknownAllowedLinkInEnvironmentIsAnError) {
     EXPECT_NE(std::string(e.what()).find("custom.json"), std::string::npos);
     EXPECT_NE(std::string(e.what()).find("no_such_link"), std::string::npos);
     EXPECT_NE(std::string(e.what()).find("@base"), std::string::npos) << "names the way out";
+  }
+}
+
+// `--env shelf` (a bundled scene by name) works from any folder; a file name that is missing is
+// an error, never silently the bundled file of that name; an unknown name lists the bundled.
+TEST(Collision, BundledScenesByName) {
+  const Environment by_name = load_environment("shelf");
+  EXPECT_EQ(by_name.identity, env_file("shelf").identity);
+  EXPECT_EQ(std::filesystem::path(by_name.path).filename(), "shelf.json");
+  for (const std::string& missing : {std::string("no-such-scene"), std::string("table.json")}) {
+    if (std::filesystem::exists(missing)) continue;  // a file of that name here: not a name
+    try {
+      load_environment(missing);
+      ADD_FAILURE() << missing << " was loaded";
+    } catch (const Error& e) {
+      const std::string message = e.what();
+      EXPECT_EQ(message.rfind(missing + ":", 0), 0u) << message;
+      if (missing == "no-such-scene") {
+        EXPECT_NE(message.find("empty, shelf, table"), std::string::npos) << message;
+      }
+    }
   }
 }
 

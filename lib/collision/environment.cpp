@@ -1,5 +1,6 @@
 #include "lazyboe/collision/environment.h"
 
+#include <algorithm>
 #include <filesystem>
 #include <set>
 
@@ -23,9 +24,31 @@ const RealRange kQuaternionComponent{-1e3, 1e3};
 
 std::string default_environment_path() { return data_dir() + "/environments/table.json"; }
 
+std::string resolve_environment_path(const std::string& path) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (path.empty() || fs::exists(path, ec)) return path;
+  const fs::path given(path);
+  // A path or a file name is a file: never silently another one (a missing table.json is not
+  // the bundled table). Only a bare name ("shelf") names a bundled scene.
+  if (given.has_parent_path() || given.has_extension()) return path;
+  const fs::path dir = fs::path(data_dir()) / "environments";
+  const fs::path bundled = dir / (path + ".json");
+  if (fs::exists(bundled, ec)) return bundled.string();
+  std::vector<std::string> found;
+  for (const auto& entry : fs::directory_iterator(dir, ec))
+    if (entry.path().extension() == ".json") found.push_back(entry.path().stem().string());
+  std::sort(found.begin(), found.end());
+  std::string names;
+  for (const std::string& name : found) names += (names.empty() ? "" : ", ") + name;
+  fail(path, "no such file, nor a bundled scene of that name (" +
+                 (names.empty() ? std::string("none found in ") + dir.string() : names) + ")");
+}
+
 Environment load_environment(const std::string& path) {
-  const nlohmann::json doc = load_json_file(path);
-  return environment_from_json(JsonField(doc, path, ""), path);
+  const std::string file = resolve_environment_path(path);
+  const nlohmann::json doc = load_json_file(file);
+  return environment_from_json(JsonField(doc, file, ""), file);
 }
 
 namespace {

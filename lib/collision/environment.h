@@ -38,7 +38,14 @@ struct Environment {
   std::string identity;
 };
 
-// Throws Error naming the file and field for anything missing or malformed.
+// `path` itself when it exists; else, for a bare name without folder or extension ("shelf"),
+// the bundled scene of that name in data_dir()/environments. Throws Error naming `path` and
+// listing the bundled scenes when neither exists; a path with a folder or an extension is
+// returned as it is (a missing file is its own error, never silently another file).
+std::string resolve_environment_path(const std::string& path);
+
+// Throws Error naming the file and field for anything missing or malformed. `path` may be a
+// bundled scene's name (resolve_environment_path).
 Environment load_environment(const std::string& path);
 // The same for an environment object held in memory (a query's inline scene); `path`: the file
 // it came from, or empty. Files the objects name are relative to the file's folder (to the
