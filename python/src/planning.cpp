@@ -310,6 +310,21 @@ void bind_result_extras(py::class_<PyResult>& c) {
           "The scene it was planned in: {'name', 'hash'}.");
 }
 
+// The wall times beside time_to_first_solution.
+void bind_result_timings(py::class_<PyResult>& c) {
+  c.def_property_readonly(
+       "planning_seconds", [](const PyResult& r) { return r.answer.planning_seconds; },
+       "Wall time of planning, s (the whole budget unless stop_at_first).")
+      .def_property_readonly(
+          "time_to_executable",
+          [](const PyResult& r) -> py::object {
+            if (!r.result().success) return py::none();
+            return py::float_(r.answer.seconds);
+          },
+          "Seconds from the start of planning to the returned trajectory (post-processing "
+          "included); None without one.");
+}
+
 void bind_result(py::module_& m) {
   bind_trajectory(m);
   auto opt = [](bool present, double v) -> py::object {
@@ -318,6 +333,7 @@ void bind_result(py::module_& m) {
   py::class_<PyResult> result(m, "PlanResult",
                               "The answer to one query, with the result line's names.");
   bind_result_extras(result);
+  bind_result_timings(result);
   result
       .def_property_readonly(
           "id", [](const PyResult& r) { return r.query.id; }, "The query id.")
@@ -333,14 +349,6 @@ void bind_result(py::module_& m) {
             return opt(r.result().success, r.result().time_to_first_solution);
           },
           "Seconds to the first solution; None without one.")
-      .def_property_readonly(
-          "planning_seconds", [](const PyResult& r) { return r.answer.planning_seconds; },
-          "Wall time of planning, s (the whole budget unless stop_at_first).")
-      .def_property_readonly(
-          "time_to_executable",
-          [opt](const PyResult& r) { return opt(r.result().success, r.answer.seconds); },
-          "Seconds from the start of planning to the returned trajectory (post-processing "
-          "included); None without one.")
       .def_property_readonly(
           "n_solutions", [](const PyResult& r) { return r.result().n_solutions; },
           "Solutions found within the budget.")
