@@ -45,15 +45,6 @@ std::string config(const std::string& j1_extra, const std::string& j2_extra) {
     "collision": {"margin": 0.005, "allowed_pairs": []}})";
 }
 
-std::string error_of(const std::string& path) {
-  try {
-    load_robot(path);
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
-}
-
 TEST(ContinuousJoint, LoadsWithTheDefaultRangeOrTheConfigs) {
   test::write_temp_file("turner/turner.urdf", kUrdf);
   const RobotModel plain = load_robot(test::write_temp_file("turner/plain.json", config("", "")));
@@ -72,12 +63,12 @@ TEST(ContinuousJoint, LoadsWithTheDefaultRangeOrTheConfigs) {
 
 TEST(ContinuousJoint, BadRangesAndMissingLimitsAreOneLineErrors) {
   test::write_temp_file("turner/turner.urdf", kUrdf);
-  const std::string on_revolute = error_of(
+  const std::string on_revolute = test::robot_load_error(
       test::write_temp_file("turner/r1.json", config(R"(, "position_range": [-1, 1])", "")));
   EXPECT_NE(on_revolute.find("position_range"), std::string::npos) << on_revolute;
   EXPECT_NE(on_revolute.find("only a continuous joint"), std::string::npos) << on_revolute;
   for (const std::string bad : {R"([3, -3])", R"([1])", R"("wide")", R"([0, 1e9])"}) {
-    const std::string message = error_of(
+    const std::string message = test::robot_load_error(
         test::write_temp_file("turner/bad.json", config("", R"(, "position_range": )" + bad)));
     EXPECT_NE(message.find("position_range"), std::string::npos) << bad << ": " << message;
     EXPECT_EQ(message.find('\n'), std::string::npos) << message;
@@ -87,7 +78,7 @@ TEST(ContinuousJoint, BadRangesAndMissingLimitsAreOneLineErrors) {
   urdf.replace(urdf.find(limit), limit.size(), "");
   test::write_temp_file("nolimit/turner.urdf", urdf);
   const std::string message =
-      error_of(test::write_temp_file("nolimit/turner.json", config("", "")));
+      test::robot_load_error(test::write_temp_file("nolimit/turner.json", config("", "")));
   EXPECT_NE(message.find("j2"), std::string::npos) << message;
   EXPECT_NE(message.find("limit"), std::string::npos) << message;
 }

@@ -9,15 +9,6 @@
 namespace lazyboe {
 namespace {
 
-std::string error_of(const std::string& config_path) {
-  try {
-    load_robot(config_path);
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
-}
-
 TEST(RobotModel, PandaHasSevenJointsWithPublishedLimits) {
   const RobotModel& robot = test::panda();
   EXPECT_EQ(robot.name, "panda");
@@ -99,7 +90,8 @@ TEST(RobotModel, GenericChainWithPrismaticJointAndFixedSensor) {
 
 TEST(RobotModel, BranchingUrdfNeedsATipLink) {
   test::write_temp_file("arm/arm.urdf", kArmUrdf);
-  const std::string message = error_of(test::write_temp_file("arm/branch.json", arm_config("")));
+  const std::string message =
+      test::robot_load_error(test::write_temp_file("arm/branch.json", arm_config("")));
   EXPECT_NE(message.find("branches at link 'c'"), std::string::npos) << message;
   EXPECT_NE(message.find("tip_link"), std::string::npos) << message;
 }
@@ -131,7 +123,7 @@ TEST(RobotModel, JointLoopsAndLinksWithTwoParentsAreRefused) {
     test::write_temp_file("loop/arm.urdf", urdf);
     for (const std::string extra : {"", R"("tip_link": "c",)"}) {
       const std::string message =
-          error_of(test::write_temp_file("loop/arm.json", arm_config(extra)));
+          test::robot_load_error(test::write_temp_file("loop/arm.json", arm_config(extra)));
       EXPECT_NE(message.find("arm.urdf:"), std::string::npos) << message;
       EXPECT_NE(message.find(expected), std::string::npos) << message;
     }
@@ -152,7 +144,8 @@ TEST(RobotModel, ConfigJointsMustMatchTheChain) {
   test::write_temp_file("arm/arm.urdf", kArmUrdf);
   std::string config = arm_config(R"("tip_link": "c",)");
   config.replace(config.find("\"j3\""), 4, "\"j9\"");
-  const std::string message = error_of(test::write_temp_file("arm/badjoint.json", config));
+  const std::string message =
+      test::robot_load_error(test::write_temp_file("arm/badjoint.json", config));
   EXPECT_NE(message.find("joints[2].name"), std::string::npos) << message;
   EXPECT_NE(message.find("j9"), std::string::npos) << message;
 }

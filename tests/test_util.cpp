@@ -10,6 +10,7 @@
 #include <random>
 #include <sstream>
 
+#include "lazyboe/common/error.h"
 #include "lazyboe/common/hash.h"
 
 namespace lazyboe::test {
@@ -114,6 +115,15 @@ Bundle viewable_bundle(size_t n, int dof, uint64_t seed) {
     p.p_collision.push_back(collision / 4.0);
   }
   return b;
+}
+
+std::string robot_load_error(const std::string& config_path) {
+  try {
+    load_robot(config_path);
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
 }
 
 const RobotModel& panda() {

@@ -14,6 +14,8 @@ std::string source_path(const std::string& relative);  // inside the repository
 std::string tool_path(const std::string& tool);        // build/bin/<tool>
 
 const RobotModel& panda();  // loaded once per test binary
+// What load_robot(config_path) throws, or "" when it loads.
+std::string robot_load_error(const std::string& config_path);
 
 // The bundled Panda in one of the bundled environments, with a simulator over them.
 struct Scene {

@@ -261,8 +261,9 @@ int LazySpSearch::expand(int p) {
     next_ = from_ + step_;
     if (!within_limits(next_)) continue;
     Predicted c;
-    c.g = g + step_.norm() + risk(e) + set_.edge_penalty;
-    c.length = length + step_.norm();  // |qf - q0| is a lower bound of the arc length
+    const double displacement = step_.norm();  // a lower bound of the edge's arc length
+    c.g = g + displacement + risk(e) + set_.edge_penalty;
+    c.length = length + displacement;
     const double h = s_.heuristic(next_);
     if (prunable(c.length, h)) continue;
     c.cell = cell(next_);
