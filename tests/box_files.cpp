@@ -67,6 +67,37 @@ std::string BoxFiles::binary_stl() const {
   return write_temp_file(name + ".stl", bytes);
 }
 
+std::string BoxFiles::collada() const {
+  const TriangleMesh m = mesh();
+  std::string positions, indices;
+  for (const Eigen::Vector3d& v : m.vertices)
+    positions +=
+        std::to_string(v.x()) + " " + std::to_string(v.y()) + " " + std::to_string(v.z()) + " ";
+  for (const Eigen::Vector3i& t : m.triangles)
+    indices += std::to_string(t[0]) + " " + std::to_string(t[1]) + " " + std::to_string(t[2]) + " ";
+  const std::string n = std::to_string(m.vertices.size()), t = std::to_string(m.triangles.size());
+  return write_temp_file(name + ".dae", R"(<?xml version="1.0" encoding="utf-8"?>
+<COLLADA xmlns="http://www.collada.org/2005/11/COLLADASchema" version="1.4.1">
+  <asset><unit name="meter" meter="1"/><up_axis>Z_UP</up_axis></asset>
+  <library_geometries><geometry id="box"><mesh>
+    <source id="pos"><float_array id="pos-array" count=")" +
+                                            std::to_string(3 * m.vertices.size()) + R"(">)" +
+                                            positions + R"(</float_array>
+      <technique_common><accessor source="#pos-array" count=")" +
+                                            n + R"(" stride="3">
+        <param name="X" type="float"/><param name="Y" type="float"/><param name="Z" type="float"/>
+      </accessor></technique_common></source>
+    <vertices id="vtx"><input semantic="POSITION" source="#pos"/></vertices>
+    <triangles count=")" + t + R"("><input semantic="VERTEX" source="#vtx" offset="0"/><p>)" +
+                                            indices + R"(</p></triangles>
+  </mesh></geometry></library_geometries>
+  <library_visual_scenes><visual_scene id="scene"><node id="box-node">
+    <instance_geometry url="#box"/></node></visual_scene></library_visual_scenes>
+  <scene><instance_visual_scene url="#scene"/></scene>
+</COLLADA>
+)");
+}
+
 std::string BoxFiles::ply(bool binary) const {
   const std::vector<Eigen::Vector3d> pts = points();
   std::string text = std::string("ply\nformat ") + (binary ? "binary_little_endian" : "ascii") +

@@ -1,6 +1,6 @@
-// One box as every kind of obstacle file (issue 26): a triangle mesh (OBJ, binary STL), a point
-// cloud filling its volume (PLY, ASCII or binary; the points themselves) and an OctoMap .bt of
-// those points; for the tests that check they all block alike.
+// One box as every kind of obstacle file (issue 26): a triangle mesh (OBJ, binary STL, COLLADA), a
+// point cloud filling its volume (PLY, ASCII or binary; the points themselves) and an OctoMap .bt
+// of those points; for the tests that check they all block alike.
 #pragma once
 
 #include <Eigen/Core>
@@ -20,6 +20,7 @@ struct BoxFiles {
   std::vector<Eigen::Vector3d> points() const;  // base frame, every half resolution
   std::string obj() const;
   std::string binary_stl() const;
+  std::string collada() const;  // Z_UP, in metres
   std::string ply(bool binary) const;
   std::string bt() const;
 };

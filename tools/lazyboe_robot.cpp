@@ -72,8 +72,32 @@ std::string shape_text(const Shape& s) {
     case ShapeType::Box:
       std::snprintf(buf, sizeof buf, "box %.4gx%.4gx%.4g", s.size.x(), s.size.y(), s.size.z());
       break;
+    case ShapeType::Mesh:
+      std::snprintf(buf, sizeof buf, "mesh of %zu triangles", s.mesh->triangles.size());
+      break;
   }
   return buf;
+}
+
+// The shape, and for a URDF mesh how it is represented: "capsule r=0.06 l=0.1 (fitted to
+// meshes/x.stl, over-approximation 4.1 mm)" or "mesh of 980 triangles (exact: meshes/x.stl)".
+std::string body_text(const CollisionBody& c) {
+  std::string text = shape_text(c.shape);
+  if (c.mesh_file.empty()) return text;
+  if (c.representation == MeshRepresentation::Exact) return text + " (exact: " + c.mesh_file + ")";
+  char buf[64];
+  std::snprintf(buf, sizeof buf, ", over-approximation %.1f mm)", 1000 * c.over_approximation);
+  return text + " (fitted to " + c.mesh_file + buf;
+}
+
+json body_json(const RobotModel& robot, const CollisionBody& c) {
+  json j = {{"name", c.name}, {"link", robot.links[c.link].name}, {"shape", shape_text(c.shape)}};
+  if (c.mesh_file.empty()) return j;
+  j["mesh_file"] = c.mesh_file;
+  j["representation"] = mesh_representation_name(c.representation);
+  if (c.representation == MeshRepresentation::Fitted)
+    j["over_approximation_mm"] = 1000 * c.over_approximation;
+  return j;
 }
 
 int cmd_info(const RobotModel& robot, bool as_json) {
@@ -108,8 +132,7 @@ int cmd_info(const RobotModel& robot, bool as_json) {
           {{"name", l.name}, {"moved_by", l.body < 0 ? "base" : robot.joints[l.body].name}});
     }
     for (const CollisionBody& c : robot.collision_bodies) {
-      j["collision_bodies"].push_back(
-          {{"name", c.name}, {"link", robot.links[c.link].name}, {"shape", shape_text(c.shape)}});
+      j["collision_bodies"].push_back(body_json(robot, c));
     }
     j["collision_margin"] = robot.collision_margin;
     for (const auto& [a, b] : robot.allowed_pairs) {
@@ -149,7 +172,7 @@ int cmd_info(const RobotModel& robot, bool as_json) {
   std::printf("\ncollision bodies (margin %g m):\n", robot.collision_margin);
   for (const CollisionBody& c : robot.collision_bodies) {
     std::printf("  %-16s %-14s %s\n", c.name.c_str(), robot.links[c.link].name.c_str(),
-                shape_text(c.shape).c_str());
+                body_text(c).c_str());
   }
   std::printf("allowed-collision link pairs: %zu; body pairs tested for self-collision: %zu\n",
               robot.allowed_pairs.size(), cm.self_pairs.size());

@@ -10,7 +10,9 @@
 namespace lazyboe {
 
 std::string robot_identity(const RobotModel& robot) {
-  return hash_files({robot.config_path, robot.urdf_path});
+  std::vector<std::string> files = {robot.config_path, robot.urdf_path};
+  files.insert(files.end(), robot.resource_files.begin(), robot.resource_files.end());
+  return hash_files(files);
 }
 
 std::string environment_identity(const Environment& env) {

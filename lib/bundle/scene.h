@@ -10,7 +10,7 @@
 namespace lazyboe {
 
 // Content identity of the inputs, as recorded in a bundle header.
-std::string robot_identity(const RobotModel& robot);  // hash of config + URDF bytes
+std::string robot_identity(const RobotModel& robot);  // hash of config, URDF and mesh bytes
 std::string environment_identity(const Environment& env);
 
 // The robot and environment a bundle was built with: the files given, or those recorded in the

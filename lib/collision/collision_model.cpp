@@ -16,6 +16,21 @@ namespace {
 static_assert(sizeof(CollisionShapes::Robot) == sizeof(Eigen::Vector3d),
               "a robot shape's record has the stride of its sphere centre");
 
+// A mesh as FCL's bounding volume hierarchy (oriented boxes with swept spheres, for collision
+// and distance alike).
+std::shared_ptr<fcl::CollisionGeometryd> mesh_geometry(const TriangleMesh& mesh) {
+  auto bvh = std::make_shared<fcl::BVHModel<fcl::OBBRSSd>>();
+  std::vector<fcl::Triangle> triangles;
+  triangles.reserve(mesh.triangles.size());
+  for (const Eigen::Vector3i& t : mesh.triangles) triangles.emplace_back(t[0], t[1], t[2]);
+  bvh->beginModel(static_cast<int>(triangles.size()), static_cast<int>(mesh.vertices.size()));
+  bvh->addSubModel(mesh.vertices, triangles);
+  bvh->endModel();
+  bvh->computeLocalAABB();
+  return bvh;
+}
+
+// `inflate` grows a primitive by the margin; a mesh is not grown (its pairs compare distances).
 std::shared_ptr<fcl::CollisionGeometryd> make_geometry(const Shape& s, double inflate) {
   switch (s.type) {
     case ShapeType::Sphere:
@@ -26,6 +41,8 @@ std::shared_ptr<fcl::CollisionGeometryd> make_geometry(const Shape& s, double in
       return std::make_shared<fcl::Cylinderd>(s.radius + inflate, s.length + 2 * inflate);
     case ShapeType::Box:
       return std::make_shared<fcl::Boxd>(s.size + Eigen::Vector3d::Constant(2 * inflate));
+    case ShapeType::Mesh:
+      return mesh_geometry(*s.mesh);
   }
   return nullptr;
 }
@@ -40,6 +57,11 @@ double bounding_radius(const Shape& s) {
       return std::hypot(s.radius, s.length / 2);
     case ShapeType::Box:
       return s.size.norm() / 2;
+    case ShapeType::Mesh: {
+      double r = 0;
+      for (const Eigen::Vector3d& v : s.mesh->vertices) r = std::max(r, v.norm());
+      return r;
+    }
   }
   return 0;
 }
@@ -54,22 +76,13 @@ Eigen::Vector3d bounding_half_extents(const Shape& s) {
       return Eigen::Vector3d(s.radius, s.radius, s.length / 2);
     case ShapeType::Box:
       return s.size / 2;
+    case ShapeType::Mesh: {
+      Eigen::Vector3d half = Eigen::Vector3d::Zero();
+      for (const Eigen::Vector3d& v : s.mesh->vertices) half = half.cwiseMax(v.cwiseAbs());
+      return half;
+    }
   }
   return Eigen::Vector3d::Zero();
-}
-
-// A mesh as FCL's bounding volume hierarchy (oriented boxes with swept spheres, for collision
-// and distance alike).
-std::shared_ptr<fcl::CollisionGeometryd> mesh_geometry(const TriangleMesh& mesh) {
-  auto bvh = std::make_shared<fcl::BVHModel<fcl::OBBRSSd>>();
-  std::vector<fcl::Triangle> triangles;
-  triangles.reserve(mesh.triangles.size());
-  for (const Eigen::Vector3i& t : mesh.triangles) triangles.emplace_back(t[0], t[1], t[2]);
-  bvh->beginModel(static_cast<int>(triangles.size()), static_cast<int>(mesh.vertices.size()));
-  bvh->addSubModel(mesh.vertices, triangles);
-  bvh->endModel();
-  bvh->computeLocalAABB();
-  return bvh;
 }
 
 std::shared_ptr<fcl::CollisionGeometryd> obstacle_geometry(const Obstacle& o) {
@@ -159,12 +172,27 @@ inline bool is_primitive(const fcl::CollisionGeometryd* g) {
 double narrow_distance(CollisionData& data, const fcl::CollisionGeometryd* g1,
                        const fcl::Transform3d& t1, const fcl::CollisionGeometryd* g2,
                        const fcl::Transform3d& t2) {
-  if (is_primitive(g2) ? narrow_collide(g1, t1, g2, t2) : collide_with_bvh(data, g1, t1, g2, t2))
+  if (is_primitive(g1) && is_primitive(g2) ? narrow_collide(g1, t1, g2, t2)
+                                           : collide_with_bvh(data, g1, t1, g2, t2))
     return 0;
   data.scratch->distance_result.clear();
   const double d =
       fcl::distance(g1, t1, g2, t2, data.scratch->distance_request, data.scratch->distance_result);
   return std::max(0.0, d);
+}
+
+// A pair with a robot mesh (exact representation) in it: FCL's collision of the two, then, when
+// they do not touch, their distance against the margin (a mesh cannot be grown as a primitive).
+[[gnu::noinline]] bool mesh_pair_collides(const CollisionData& data, double margin,
+                                          const fcl::CollisionGeometryd* g1,
+                                          const fcl::Transform3d& t1,
+                                          const fcl::CollisionGeometryd* g2,
+                                          const fcl::Transform3d& t2) {
+  if (collide_with_bvh(data, g1, t1, g2, t2)) return true;
+  if (!(margin > 0)) return false;
+  CollisionScratch& s = *data.scratch;
+  s.distance_result.clear();
+  return fcl::distance(g1, t1, g2, t2, s.distance_request, s.distance_result) < margin;
 }
 
 // Signed distance of two capsules by FCL's closed-form segment-segment routine: much cheaper
@@ -184,6 +212,9 @@ bool self_collides(const CollisionShapes& shapes, const CollisionData& data, int
   const CollisionShapes::Robot& sa = shapes.robot[a];
   const CollisionShapes::Robot& sb = shapes.robot[b];
   if (shapes.capsule[a] && shapes.capsule[b]) return capsule_distance(shapes, data, a, b) < margin;
+  if (!sa.inflated || !sb.inflated)  // a mesh
+    return mesh_pair_collides(data, margin, sa.exact, data.transform[a], sb.exact,
+                              data.transform[b]);
   return narrow_collide(sa.inflated, data.transform[a], sb.exact, data.transform[b]);
 }
 
@@ -191,6 +222,9 @@ bool env_collides(const CollisionShapes& shapes, const CollisionData& data, int 
   const CollisionShapes::Robot& robot = shapes.robot[a];
   const CollisionShapes::Obstacle& obstacle = shapes.obstacles[o];
   if (!sphere_may_touch_box(data.sphere_centre[a], shapes.env_radius[a], obstacle)) return false;
+  if (!robot.inflated)  // a mesh
+    return mesh_pair_collides(data, shapes.margin, robot.exact, data.transform[a],
+                              obstacle.geometry, obstacle.transform);
   if (!obstacle.primitive)
     return collide_with_bvh(data, robot.inflated, data.transform[a], obstacle.geometry,
                             obstacle.transform);
@@ -214,7 +248,9 @@ CollisionModel build_collision_model(const RobotModel& robot, const Environment&
     s.sphere_radius = bounding_radius(cb.shape);
     CollisionShapes::Robot g;
     g.exact = own(*shapes, make_geometry(cb.shape, 0));
-    g.inflated = own(*shapes, make_geometry(cb.shape, model.margin));
+    // A mesh has no grown copy: its pairs compare distances with the margin.
+    if (cb.shape.type != ShapeType::Mesh)
+      g.inflated = own(*shapes, make_geometry(cb.shape, model.margin));
     g.sphere_radius = s.sphere_radius;
     model.robot.push_back(s);
     shapes->robot.push_back(g);

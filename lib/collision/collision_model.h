@@ -5,7 +5,8 @@
 //
 // Margin: a configuration is in collision when any tested pair is closer than the robot's
 // collision margin. One side of each pair is inflated by the margin, which is exact for
-// spheres and capsules and conservative for boxes and cylinders.
+// spheres and capsules and conservative for boxes and cylinders; a pair with a robot mesh in it
+// (a link kept exact) compares FCL's distance with the margin instead.
 #pragma once
 
 #include <Eigen/Geometry>

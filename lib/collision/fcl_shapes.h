@@ -19,7 +19,7 @@ namespace lazyboe {
 struct CollisionShapes {
   struct Robot {                                        // as CollisionModel::robot
     double sphere_radius = 0;                           // CollisionModel::RobotShape::sphere_radius
-    const fcl::CollisionGeometryd* inflated = nullptr;  // grown by the margin
+    const fcl::CollisionGeometryd* inflated = nullptr;  // grown by the margin; none for a mesh
     const fcl::CollisionGeometryd* exact = nullptr;
   };
   struct alignas(64) Obstacle {  // as CollisionModel::obstacles

@@ -1,5 +1,6 @@
 #include "lazyboe/collision/mesh.h"
 
+#include <assimp/config.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 #include <octomap/OcTree.h>
@@ -54,6 +55,9 @@ void add_node(const aiScene& scene, const aiNode& node, const aiMatrix4x4& paren
 
 TriangleMesh load_mesh(const std::string& path, const Eigen::Vector3d& scale) {
   Assimp::Importer importer;
+  // A COLLADA file's vertices as written (z up, as ROS, RViz and MoveIt read them): Assimp
+  // would otherwise turn a Z_UP file to y up. Its <unit> still scales.
+  importer.SetPropertyBool(AI_CONFIG_IMPORT_COLLADA_IGNORE_UP_DIRECTION, true);
   const aiScene* scene =
       read_scene(importer, path,
                  aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_SortByPType);

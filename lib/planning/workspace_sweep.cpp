@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "lazyboe/collision/mesh.h"
 #include "lazyboe/common/error.h"
 
 namespace lazyboe {
@@ -35,6 +36,10 @@ SweptShape swept_shape(const RobotModel& robot, const CollisionBody& cb) {
       break;
     case ShapeType::Box:
       s.radius = cb.shape.size.norm() / 2;
+      break;
+    case ShapeType::Mesh:  // about its bounding box's centre, the shape's frame
+      for (const Eigen::Vector3d& v : cb.shape.mesh->vertices)
+        s.radius = std::max(s.radius, v.norm());
       break;
   }
   s.radius += robot.collision_margin;

@@ -16,6 +16,7 @@
 #include <set>
 #include <sstream>
 
+#include "lazyboe/collision/link_geometry.h"
 #include "lazyboe/common/error.h"
 #include "lazyboe/common/file_checks.h"
 #include "lazyboe/common/json_fields.h"
@@ -23,6 +24,7 @@
 #include "lazyboe/robot/dynamics.h"
 #include "lazyboe/robot/kinematics.h"
 #include "lazyboe/robot/urdf_check.h"
+#include "lazyboe/robot/urdf_pose.h"
 
 namespace lazyboe {
 namespace {
@@ -38,12 +40,6 @@ class CapturingOutputHandler : public console_bridge::OutputHandler {
   }
   std::string last_error;
 };
-
-Pose pose_from_urdf(const urdf::Pose& pose) {
-  Eigen::Quaterniond rotation(pose.rotation.w, pose.rotation.x, pose.rotation.y, pose.rotation.z);
-  return Pose(rotation.normalized().toRotationMatrix(),
-              Eigen::Vector3d(pose.position.x, pose.position.y, pose.position.z));
-}
 
 urdf::ModelInterfaceSharedPtr parse_urdf_file(const std::string& path) {
   require_input_file(path, "URDF file");
@@ -132,88 +128,6 @@ Friction read_friction(const JsonField& f) {
   return friction;
 }
 
-// Collision elements of one URDF link. A cylinder capped by two spheres of its radius at its
-// ends is the usual URDF spelling of a capsule; it becomes one capsule (cheaper and exact).
-void add_collision_bodies(RobotModel& model, const std::string& urdf_path, const urdf::Link& link,
-                          int link_index) {
-  struct Element {
-    std::string name;
-    Shape shape;
-    Pose pose;
-    bool used = false;
-  };
-  std::vector<Element> elements;
-  for (size_t k = 0; k < link.collision_array.size(); ++k) {
-    const urdf::Collision& c = *link.collision_array[k];
-    const std::string where =
-        urdf_path + ": link '" + link.name + "' collision " + std::to_string(k);
-    if (!c.geometry) fail(where, "missing geometry");
-    Element e;
-    e.name = c.name.empty() ? link.name + "_" + std::to_string(k) : c.name;
-    e.pose = pose_from_urdf(c.origin);
-    switch (c.geometry->type) {
-      case urdf::Geometry::SPHERE: {
-        e.shape.type = ShapeType::Sphere;
-        e.shape.radius = static_cast<const urdf::Sphere&>(*c.geometry).radius;
-        if (!(e.shape.radius > 0)) fail(where, "sphere radius must be > 0");
-        break;
-      }
-      case urdf::Geometry::BOX: {
-        const urdf::Vector3& dim = static_cast<const urdf::Box&>(*c.geometry).dim;
-        e.shape.type = ShapeType::Box;
-        e.shape.size = Eigen::Vector3d(dim.x, dim.y, dim.z);
-        if (!(e.shape.size.minCoeff() > 0)) fail(where, "box size must be > 0");
-        break;
-      }
-      case urdf::Geometry::CYLINDER: {
-        const auto& cyl = static_cast<const urdf::Cylinder&>(*c.geometry);
-        e.shape.type = ShapeType::Cylinder;
-        e.shape.radius = cyl.radius;
-        e.shape.length = cyl.length;
-        if (!(cyl.radius > 0 && cyl.length > 0)) fail(where, "cylinder size must be > 0");
-        break;
-      }
-      default:
-        fail(where,
-             "only sphere, box and cylinder collision geometry is supported (write a capsule "
-             "as a cylinder plus two spheres; replace meshes by primitives)");
-    }
-    elements.push_back(e);
-  }
-  const double tol = 1e-6;
-  for (Element& cyl : elements) {
-    if (cyl.shape.type != ShapeType::Cylinder) continue;
-    const Eigen::Vector3d axis = cyl.pose.R.col(2);
-    const double half = cyl.shape.length / 2;
-    Element* caps[2] = {nullptr, nullptr};
-    for (int end = 0; end < 2; ++end) {
-      const Eigen::Vector3d centre = cyl.pose.p + (end == 0 ? half : -half) * axis;
-      for (Element& s : elements) {
-        if (!s.used && s.shape.type == ShapeType::Sphere &&
-            std::abs(s.shape.radius - cyl.shape.radius) < tol && (s.pose.p - centre).norm() < tol) {
-          caps[end] = &s;
-          break;
-        }
-      }
-    }
-    if (caps[0] && caps[1] && caps[0] != caps[1]) {
-      caps[0]->used = caps[1]->used = true;
-      cyl.shape.type = ShapeType::Capsule;
-      for (const char* suffix : {"_cylinder", "_cyl"}) {
-        const size_t n = std::string(suffix).size();
-        if (cyl.name.size() > n && cyl.name.compare(cyl.name.size() - n, n, suffix) == 0) {
-          cyl.name.resize(cyl.name.size() - n);
-          break;
-        }
-      }
-    }
-  }
-  for (const Element& e : elements) {
-    if (e.used) continue;
-    model.collision_bodies.push_back({e.name, link_index, e.shape, e.pose});
-  }
-}
-
 // A continuous joint's planned range: [lower, upper], rad, finite, lower < upper.
 void read_position_range(const JsonField& field, Joint& joint) {
   if (!joint.continuous) {
@@ -278,8 +192,14 @@ const char* shape_type_name(ShapeType type) {
       return "cylinder";
     case ShapeType::Capsule:
       return "capsule";
+    case ShapeType::Mesh:
+      return "mesh";
   }
   return "?";
+}
+
+const char* mesh_representation_name(MeshRepresentation representation) {
+  return representation == MeshRepresentation::Exact ? "exact" : "fitted";
 }
 
 int RobotModel::link_index(const std::string& link_name) const {
@@ -453,13 +373,41 @@ void read_controller(RobotModel& model, const JsonField& root) {
   model.controller.present = true;
 }
 
-void read_collision(RobotModel& model, const JsonField& root, const std::string& upath,
+MeshRepresentation mesh_representation(const JsonField& field) {
+  const std::string name = field.string();
+  if (name == "fitted") return MeshRepresentation::Fitted;
+  if (name == "exact") return MeshRepresentation::Exact;
+  field.fail("unknown mesh representation '" + name + "' (expected fitted or exact)");
+}
+
+// collision.meshes: {"representation": "fitted" | "exact", "links": {"<link>": "exact", ...}}.
+MeshSettings read_mesh_settings(const RobotModel& model, const JsonField& collision) {
+  MeshSettings settings;
+  if (!collision.has("meshes")) return settings;
+  const JsonField meshes = collision.at("meshes");
+  meshes.allow_only({"representation", "links"});
+  if (meshes.has("representation"))
+    settings.representation = mesh_representation(meshes.at("representation"));
+  if (!meshes.has("links")) return settings;
+  const JsonField links = meshes.at("links");
+  if (!links.value().is_object()) links.fail("expected an object: link name -> fitted or exact");
+  for (const auto& item : links.value().items()) {
+    const std::string& link = item.key();
+    const JsonField entry = links.at(link);
+    if (model.link_index(link) < 0) entry.fail("unknown link '" + link + "'");
+    settings.per_link.emplace_back(link, mesh_representation(entry));
+  }
+  return settings;
+}
+
+void read_collision(RobotModel& model, const JsonField& root,
                     const std::vector<urdf::LinkConstSharedPtr>& link_sources) {
   const JsonField collision = root.at("collision");
-  collision.allow_only({"margin", "allowed_pairs"});
+  collision.allow_only({"margin", "allowed_pairs", "meshes"});
   model.collision_margin = collision.at("margin").number_in(kCollisionMargin, " m");
+  const MeshSettings meshes = read_mesh_settings(model, collision);
   for (size_t i = 0; i < model.links.size(); ++i) {
-    add_collision_bodies(model, upath, *link_sources[i], static_cast<int>(i));
+    add_link_collision_bodies(model, *link_sources[i], static_cast<int>(i), meshes);
   }
   if (!collision.has("allowed_pairs")) return;
   for (const JsonField& pair : collision.at("allowed_pairs").items()) {
@@ -543,7 +491,7 @@ RobotModel load_robot(const std::string& config_path) {
   const JsonField root(config, config_path, "");
   root.allow_only({"schema_version", "name", "description", "urdf", "base_link", "tip_link",
                    "gravity", "control_rate", "joints", "collision", "controller",
-                   "sampling_region"});
+                   "sampling_region", "package_path"});
   if (root.at("schema_version").integer() != 1) {
     root.at("schema_version").fail("unsupported version (this build reads version 1)");
   }
@@ -553,6 +501,11 @@ RobotModel load_robot(const std::string& config_path) {
   model.name = root.at("name").string();
   const std::string urdf_rel = root.at("urdf").string();
   model.urdf_path = (fs::path(config_path).parent_path() / urdf_rel).lexically_normal().string();
+  if (root.has("package_path")) {
+    for (const JsonField& dir : root.at("package_path").items())
+      model.package_path.push_back(
+          (fs::path(config_path).parent_path() / dir.string()).lexically_normal().string());
+  }
   if (root.has("gravity")) model.gravity = root.at("gravity").vec3_in(kGravity, " m/s^2");
   if (root.has("control_rate")) {
     const long rate = root.at("control_rate").integer();
@@ -570,7 +523,7 @@ RobotModel load_robot(const std::string& config_path) {
 
   read_config_joints(model, root);
   read_controller(model, root);
-  read_collision(model, root, upath, link_sources);
+  read_collision(model, root, link_sources);
   fill_limits(model);
   read_sampling_region(model, root);
   check_mass_matrix(model, upath);

@@ -3,6 +3,7 @@
 // scratch lives in RobotData (kinematics.h).
 #pragma once
 
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -64,20 +65,34 @@ struct Link {
   Pose in_body;   // link frame in the body frame
 };
 
-enum class ShapeType { Sphere, Box, Cylinder, Capsule };
+struct TriangleMesh;  // lazyboe/collision/mesh.h
+
+enum class ShapeType { Sphere, Box, Cylinder, Capsule, Mesh };
 struct Shape {
   ShapeType type = ShapeType::Sphere;
   double radius = 0;                               // sphere, cylinder, capsule
   double length = 0;                               // cylinder, capsule: along local z
   Eigen::Vector3d size = Eigen::Vector3d::Zero();  // box: full extents
+  std::shared_ptr<const TriangleMesh> mesh;        // mesh: triangles about the shape's frame
 };
 const char* shape_type_name(ShapeType type);
+
+// How a link whose URDF collision geometry is a mesh is checked: a capsule fitted around the
+// mesh (the fast primitive checks; conservative by its over-approximation) or the mesh itself
+// (FCL's bounding volume hierarchy: exact, slower).
+enum class MeshRepresentation { Fitted, Exact };
+const char* mesh_representation_name(MeshRepresentation representation);
 
 struct CollisionBody {
   std::string name;
   int link = 0;  // index into RobotModel::links
   Shape shape;
   Pose in_link;  // shape frame in the link frame
+  // For URDF mesh geometry: the file, how it is represented, and for a fitted shape the
+  // largest distance from its surface to the mesh (m).
+  std::string mesh_file;
+  MeshRepresentation representation = MeshRepresentation::Fitted;
+  double over_approximation = 0;
 };
 
 // Joint-level controller used to simulate the robot following joint-velocity commands: a
@@ -96,6 +111,8 @@ struct RobotModel {
   std::string name;
   std::string config_path;
   std::string urdf_path;
+  std::vector<std::string> resource_files;  // files the URDF names (meshes): part of its identity
+  std::vector<std::string> package_path;    // config "package_path", resolved: package:// folders
   int dof = 0;
   Eigen::Vector3d gravity{0, 0, -9.81};
   double control_rate = 1000;  // Hz

@@ -37,13 +37,26 @@ json pose_json(const Pose& pose) {
   return {{"R", R}, {"p", {pose.p.x(), pose.p.y(), pose.p.z()}}};
 }
 
+// A triangle mesh's vertices and triangles, flat, into `out`.
+void add_triangles(const TriangleMesh& mesh, json& out) {
+  json vertices = json::array(), triangles = json::array();
+  for (const Eigen::Vector3d& v : mesh.vertices)
+    for (int c = 0; c < 3; ++c) vertices.push_back(v[c]);
+  for (const Eigen::Vector3i& t : mesh.triangles)
+    for (int c = 0; c < 3; ++c) triangles.push_back(t[c]);
+  out["vertices"] = std::move(vertices);
+  out["triangles"] = std::move(triangles);
+}
+
 json shape_json(const std::string& name, const Shape& s, const Pose& pose) {
-  return {{"name", name},
-          {"type", shape_type_name(s.type)},
-          {"radius", s.radius},
-          {"length", s.length},
-          {"size", {s.size.x(), s.size.y(), s.size.z()}},
-          {"pose", pose_json(pose)}};
+  json j = {{"name", name},
+            {"type", shape_type_name(s.type)},
+            {"radius", s.radius},
+            {"length", s.length},
+            {"size", {s.size.x(), s.size.y(), s.size.z()}},
+            {"pose", pose_json(pose)}};
+  if (s.type == ShapeType::Mesh) add_triangles(*s.mesh, j);
+  return j;
 }
 
 }  // namespace
@@ -73,16 +86,9 @@ namespace {
 
 // A mesh obstacle: its vertices and triangles, flat.
 json mesh_json(const Obstacle& o) {
-  json vertices = json::array(), triangles = json::array();
-  for (const Eigen::Vector3d& v : o.mesh->vertices)
-    for (int c = 0; c < 3; ++c) vertices.push_back(v[c]);
-  for (const Eigen::Vector3i& t : o.mesh->triangles)
-    for (int c = 0; c < 3; ++c) triangles.push_back(t[c]);
-  return {{"name", o.name},
-          {"type", "mesh"},
-          {"vertices", vertices},
-          {"triangles", triangles},
-          {"pose", pose_json(o.pose)}};
+  json j = {{"name", o.name}, {"type", "mesh"}, {"pose", pose_json(o.pose)}};
+  add_triangles(*o.mesh, j);
+  return j;
 }
 
 // An octree obstacle (a voxelised cloud, an OctoMap): its occupied cells, centres and sizes.
