@@ -120,11 +120,10 @@ TEST(Collision, FloorIsAllowedOnlyForTheBaseLinks) {
 // its base, those too.
 TEST(Collision, AtBaseIsTheBaseAndTheFirstMovingBody) {
   const RobotModel& robot = test::panda();
-  const Environment named = env_file("empty");
-  ASSERT_EQ(named.obstacles[0].allowed_links,
-            (std::vector<std::string>{"panda_link0", "panda_link1"}));
-  Environment at_base = named;
-  at_base.obstacles[0].allowed_links = {"@base"};
+  const Environment at_base = env_file("empty");
+  ASSERT_EQ(at_base.obstacles[0].allowed_links, (std::vector<std::string>{"@base"}));
+  Environment named = at_base;
+  named.obstacles[0].allowed_links = {"panda_link0", "panda_link1"};
   EXPECT_EQ(build_collision_model(robot, at_base).env_pairs,
             build_collision_model(robot, named).env_pairs);
   std::vector<int> allowed = allowed_links_of(robot, at_base.obstacles[0], "empty.json");

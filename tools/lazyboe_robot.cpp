@@ -10,10 +10,13 @@
 
 #include "lazyboe/collision/allowed_pairs.h"
 #include "lazyboe/collision/collision_model.h"
+#include "lazyboe/common/atomic_file.h"
 #include "lazyboe/common/file_checks.h"
 #include "lazyboe/io/csv.h"
 #include "lazyboe/io/trajectory_csv.h"
 #include "lazyboe/robot/dynamics.h"
+#include "lazyboe/robot/resource_path.h"
+#include "lazyboe/sim/robot_setup.h"
 #include "lazyboe/sim/trajectory_check.h"
 #include "tool_main.h"
 
@@ -337,6 +340,37 @@ int cmd_validate_trajectory(const RobotModel& robot, const std::string& env_path
 
 }  // namespace
 
+// Writes the config `init` makes, then says what it assumed and how the gains tracked.
+int cmd_init(RobotSetupOptions options, const std::string& package_path,
+             const std::string& meshes) {
+  if (meshes != "fitted" && meshes != "exact") fail("--meshes", "expected fitted or exact");
+  options.meshes = meshes == "exact" ? MeshRepresentation::Exact : MeshRepresentation::Fitted;
+  options.package_path = split_path_list(package_path);
+  refuse_output_as_input({"--out", options.out_path},
+                         {{"--urdf", options.urdf_path}, {"--srdf", options.srdf_path}});
+  const RobotSetup setup = make_robot_config(options);
+  AtomicFile file(options.out_path);
+  file.stream() << setup.config.dump(2) << "\n";
+  file.commit();
+  std::fprintf(stderr, "lazyboe-robot init: wrote %s\n", options.out_path.c_str());
+  for (const std::string& note : setup.notes) std::fprintf(stderr, "  %s\n", note.c_str());
+  int failed = 0;
+  for (const StepCheck& s : setup.steps) {
+    std::fprintf(stderr, "  velocity step on %-20s %-18s tracking error %4.0f%% of the step%s\n",
+                 s.joint.c_str(), rollout_status_name(s.status), 100 * s.tracking_error,
+                 s.passed() ? "" : "  <- check this joint's gains and limits");
+    failed += !s.passed();
+  }
+  if (failed) {
+    std::fprintf(stderr,
+                 "  %d joint(s) did not track a step within %.0f%%: edit controller.kv/ka or the "
+                 "limits in %s (docs/robot-description.md)\n",
+                 failed, 100 * kStepTrackingTolerance, options.out_path.c_str());
+  }
+  std::fprintf(stderr, "  next: lazyboe-robot info --robot %s\n", options.out_path.c_str());
+  return 0;
+}
+
 int main(int argc, char** argv) {
   CLI::App app{"Inspect a robot description: joints, kinematics, dynamics, collision."};
   app.require_subcommand(1);
@@ -387,9 +421,32 @@ int main(int argc, char** argv) {
       ->required();
   validate->add_option("--env", env_path, "Environment (JSON)")->capture_default_str();
 
+  auto* init = app.add_subcommand("init", "Write a robot config from a URDF (and an SRDF)");
+  lazyboe::RobotSetupOptions setup;
+  std::string package_path, meshes = "fitted";
+  init->add_option("--urdf", setup.urdf_path, "The robot's URDF")->required();
+  init->add_option("--srdf", setup.srdf_path, "MoveIt SRDF: a group's chain, disabled pairs");
+  init->add_option("--group", setup.srdf_group, "SRDF group (default: the first with a chain)");
+  init->add_option("--package-path", package_path, "Folders DIR[:DIR] of package:// meshes");
+  init->add_option("--base-link", setup.base_link, "Root of the planned chain");
+  init->add_option("--tip-link", setup.tip_link, "End of the planned chain (the tool flange)");
+  init->add_option("--name", setup.name, "Robot name (default: the URDF's file name)");
+  init->add_option("--meshes", meshes, "Mesh links: fitted (capsules) or exact")
+      ->capture_default_str();
+  init->add_option("--exact-links", setup.exact_links,
+                   "Mesh links kept exact (comma-separated), whatever --meshes says")
+      ->delimiter(',');
+  init->add_option("--margin", setup.margin, "Collision margin, m")->capture_default_str();
+  init->add_option("--samples", setup.pair_samples, "Configurations sampled for allowed pairs")
+      ->capture_default_str()
+      ->check(lazyboe::whole_number(false));
+  init->add_option("--seed", setup.seed, "Random seed")->capture_default_str();
+  init->add_option("--out", setup.out_path, "Robot config (JSON) to write")->required();
+
   lazyboe::one_line_cli_errors(app, "lazyboe-robot");
   CLI11_PARSE(app, argc, argv);
   return lazyboe::run_tool("lazyboe-robot", [&]() {
+    if (*init) return cmd_init(setup, package_path, meshes);
     const lazyboe::RobotModel robot = lazyboe::load_robot(robot_path);
     if (*torques || *check) {
       lazyboe::refuse_output_as_input({"--out", out_path},

@@ -486,8 +486,27 @@ void check_mass_matrix(const RobotModel& model, const std::string& upath) {
 
 }  // namespace
 
+std::vector<Joint> chain_joints(const std::string& urdf_path, const std::string& base_link,
+                                const std::string& tip_link) {
+  const urdf::ModelInterfaceSharedPtr urdf_model = parse_urdf_file(urdf_path);
+  nlohmann::json selection = nlohmann::json::object();
+  if (!base_link.empty()) selection["base_link"] = base_link;
+  if (!tip_link.empty()) selection["tip_link"] = tip_link;
+  std::string base_name;
+  RobotModel model;
+  build_bodies(model,
+               find_chain(JsonField(selection, "the chain", ""), *urdf_model, urdf_path, urdf_path,
+                          base_name),
+               urdf_path);
+  if (model.dof == 0) fail(urdf_path, "the chain from '" + base_name + "' has no moving joint");
+  return model.joints;
+}
+
 RobotModel load_robot(const std::string& config_path) {
-  const nlohmann::json config = load_json_file(config_path);
+  return robot_from_json(load_json_file(config_path), config_path);
+}
+
+RobotModel robot_from_json(const nlohmann::json& config, const std::string& config_path) {
   const JsonField root(config, config_path, "");
   root.allow_only({"schema_version", "name", "description", "urdf", "base_link", "tip_link",
                    "gravity", "control_rate", "joints", "collision", "controller",

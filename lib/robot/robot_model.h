@@ -4,6 +4,7 @@
 #pragma once
 
 #include <memory>
+#include <nlohmann/json_fwd.hpp>
 #include <string>
 #include <utility>
 #include <vector>
@@ -142,6 +143,14 @@ struct RobotModel {
 // Loads a robot config (JSON) and the URDF it points at. Throws Error naming the file and
 // field for anything missing, malformed or not physical.
 RobotModel load_robot(const std::string& config_path);
+// The same for a config held in memory; `config_path` names it in errors and is where its
+// relative paths (urdf, package_path) start.
+RobotModel robot_from_json(const nlohmann::json& config, const std::string& config_path);
+
+// The moving joints (limits as the URDF gives them) of the chain from `base_link` to
+// `tip_link` (empty: the defaults of the config's fields), for writing a config.
+std::vector<Joint> chain_joints(const std::string& urdf_path, const std::string& base_link,
+                                const std::string& tip_link);
 
 // The bundled data directory (LAZYBOE_DATA_DIR in the environment overrides the built-in one).
 std::string data_dir();
