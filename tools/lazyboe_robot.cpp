@@ -371,6 +371,31 @@ int cmd_init(RobotSetupOptions options, const std::string& package_path,
   return 0;
 }
 
+// `init`'s options, into `setup`, `package_path` and `meshes`.
+CLI::App* add_init_command(CLI::App& app, RobotSetupOptions& setup, std::string& package_path,
+                           std::string& meshes) {
+  auto* init = app.add_subcommand("init", "Write a robot config from a URDF (and an SRDF)");
+  init->add_option("--urdf", setup.urdf_path, "The robot's URDF")->required();
+  init->add_option("--srdf", setup.srdf_path, "MoveIt SRDF: a group's chain, disabled pairs");
+  init->add_option("--group", setup.srdf_group, "SRDF group (default: the first with a chain)");
+  init->add_option("--package-path", package_path, "Folders DIR[:DIR] of package:// meshes");
+  init->add_option("--base-link", setup.base_link, "Root of the planned chain");
+  init->add_option("--tip-link", setup.tip_link, "End of the planned chain (the tool flange)");
+  init->add_option("--name", setup.name, "Robot name (default: the URDF's file name)");
+  init->add_option("--meshes", meshes, "Mesh links: fitted (capsules) or exact")
+      ->capture_default_str();
+  init->add_option("--exact-links", setup.exact_links,
+                   "Mesh links kept exact (comma-separated), whatever --meshes says")
+      ->delimiter(',');
+  init->add_option("--margin", setup.margin, "Collision margin, m")->capture_default_str();
+  init->add_option("--samples", setup.pair_samples, "Configurations sampled for allowed pairs")
+      ->capture_default_str()
+      ->check(lazyboe::whole_number(false));
+  init->add_option("--seed", setup.seed, "Random seed")->capture_default_str();
+  init->add_option("--out", setup.out_path, "Robot config (JSON) to write")->required();
+  return init;
+}
+
 int main(int argc, char** argv) {
   CLI::App app{"Inspect a robot description: joints, kinematics, dynamics, collision."};
   app.require_subcommand(1);
@@ -421,27 +446,9 @@ int main(int argc, char** argv) {
       ->required();
   validate->add_option("--env", env_path, "Environment (JSON)")->capture_default_str();
 
-  auto* init = app.add_subcommand("init", "Write a robot config from a URDF (and an SRDF)");
   lazyboe::RobotSetupOptions setup;
   std::string package_path, meshes = "fitted";
-  init->add_option("--urdf", setup.urdf_path, "The robot's URDF")->required();
-  init->add_option("--srdf", setup.srdf_path, "MoveIt SRDF: a group's chain, disabled pairs");
-  init->add_option("--group", setup.srdf_group, "SRDF group (default: the first with a chain)");
-  init->add_option("--package-path", package_path, "Folders DIR[:DIR] of package:// meshes");
-  init->add_option("--base-link", setup.base_link, "Root of the planned chain");
-  init->add_option("--tip-link", setup.tip_link, "End of the planned chain (the tool flange)");
-  init->add_option("--name", setup.name, "Robot name (default: the URDF's file name)");
-  init->add_option("--meshes", meshes, "Mesh links: fitted (capsules) or exact")
-      ->capture_default_str();
-  init->add_option("--exact-links", setup.exact_links,
-                   "Mesh links kept exact (comma-separated), whatever --meshes says")
-      ->delimiter(',');
-  init->add_option("--margin", setup.margin, "Collision margin, m")->capture_default_str();
-  init->add_option("--samples", setup.pair_samples, "Configurations sampled for allowed pairs")
-      ->capture_default_str()
-      ->check(lazyboe::whole_number(false));
-  init->add_option("--seed", setup.seed, "Random seed")->capture_default_str();
-  init->add_option("--out", setup.out_path, "Robot config (JSON) to write")->required();
+  CLI::App* init = add_init_command(app, setup, package_path, meshes);
 
   lazyboe::one_line_cli_errors(app, "lazyboe-robot");
   CLI11_PARSE(app, argc, argv);
