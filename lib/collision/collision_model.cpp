@@ -16,9 +16,9 @@ namespace {
 static_assert(sizeof(CollisionShapes::Robot) == sizeof(Eigen::Vector3d),
               "a robot shape's record has the stride of its sphere centre");
 
-// A mesh as FCL's bounding volume hierarchy (oriented boxes with swept spheres, for collision
-// and distance alike).
-std::shared_ptr<fcl::CollisionGeometryd> mesh_geometry(const TriangleMesh& mesh) {
+}  // namespace
+
+std::shared_ptr<fcl::BVHModel<fcl::OBBRSSd>> mesh_geometry(const TriangleMesh& mesh) {
   auto bvh = std::make_shared<fcl::BVHModel<fcl::OBBRSSd>>();
   std::vector<fcl::Triangle> triangles;
   triangles.reserve(mesh.triangles.size());
@@ -29,6 +29,8 @@ std::shared_ptr<fcl::CollisionGeometryd> mesh_geometry(const TriangleMesh& mesh)
   bvh->computeLocalAABB();
   return bvh;
 }
+
+namespace {
 
 // `inflate` grows a primitive by the margin; a mesh is not grown (its pairs compare distances).
 std::shared_ptr<fcl::CollisionGeometryd> make_geometry(const Shape& s, double inflate) {
@@ -57,11 +59,8 @@ double bounding_radius(const Shape& s) {
       return std::hypot(s.radius, s.length / 2);
     case ShapeType::Box:
       return s.size.norm() / 2;
-    case ShapeType::Mesh: {
-      double r = 0;
-      for (const Eigen::Vector3d& v : s.mesh->vertices) r = std::max(r, v.norm());
-      return r;
-    }
+    case ShapeType::Mesh:
+      return farthest_vertex(*s.mesh);
   }
   return 0;
 }
@@ -77,9 +76,9 @@ Eigen::Vector3d bounding_half_extents(const Shape& s) {
     case ShapeType::Box:
       return s.size / 2;
     case ShapeType::Mesh: {
-      Eigen::Vector3d half = Eigen::Vector3d::Zero();
-      for (const Eigen::Vector3d& v : s.mesh->vertices) half = half.cwiseMax(v.cwiseAbs());
-      return half;
+      Eigen::Vector3d lower, upper;
+      mesh_bounds(*s.mesh, lower, upper);
+      return lower.cwiseAbs().cwiseMax(upper.cwiseAbs());
     }
   }
   return Eigen::Vector3d::Zero();
@@ -99,11 +98,7 @@ std::shared_ptr<fcl::CollisionGeometryd> obstacle_geometry(const Obstacle& o) {
 // The obstacle's own bounding box, in its frame.
 void local_bounds(const Obstacle& o, Eigen::Vector3d& lower, Eigen::Vector3d& upper) {
   if (o.type == ObstacleType::Mesh) {
-    lower = upper = o.mesh->vertices.front();
-    for (const Eigen::Vector3d& v : o.mesh->vertices) {
-      lower = lower.cwiseMin(v);
-      upper = upper.cwiseMax(v);
-    }
+    mesh_bounds(*o.mesh, lower, upper);
   } else if (o.type == ObstacleType::Octree) {
     occupied_bounds(*o.cells, lower, upper);
   } else {

@@ -38,6 +38,10 @@ struct CollisionShapes {
   std::vector<std::shared_ptr<fcl::CollisionGeometryd>> owned;  // keeps the geometry alive
 };
 
+// A mesh as FCL's bounding volume hierarchy (oriented boxes with swept spheres, for collision
+// and distance alike): obstacles, exact robot links, and the fitted shapes' gap measure.
+std::shared_ptr<fcl::BVHModel<fcl::OBBRSSd>> mesh_geometry(const TriangleMesh& mesh);
+
 // Per-thread FCL state of the exact-distance queries, and of the collision queries against
 // meshes and octrees (fcl::collide: their result's contact list keeps its capacity).
 struct CollisionScratch {

@@ -75,11 +75,8 @@ void set_mesh_shape(CollisionBody& body, TriangleMesh mesh, MeshRepresentation r
     body.over_approximation = fitted.over_approximation;
     return;
   }
-  Eigen::Vector3d lower = mesh.vertices.front(), upper = lower;
-  for (const Eigen::Vector3d& v : mesh.vertices) {
-    lower = lower.cwiseMin(v);
-    upper = upper.cwiseMax(v);
-  }
+  Eigen::Vector3d lower, upper;
+  mesh_bounds(mesh, lower, upper);
   const Eigen::Vector3d centre = (lower + upper) / 2;  // a small bounding sphere about the frame
   for (Eigen::Vector3d& v : mesh.vertices) v -= centre;
   body.shape.type = ShapeType::Mesh;

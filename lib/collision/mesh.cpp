@@ -69,6 +69,20 @@ TriangleMesh load_mesh(const std::string& path, const Eigen::Vector3d& scale) {
   return mesh;
 }
 
+void mesh_bounds(const TriangleMesh& mesh, Eigen::Vector3d& lower, Eigen::Vector3d& upper) {
+  lower = upper = mesh.vertices.front();
+  for (const Eigen::Vector3d& v : mesh.vertices) {
+    lower = lower.cwiseMin(v);
+    upper = upper.cwiseMax(v);
+  }
+}
+
+double farthest_vertex(const TriangleMesh& mesh) {
+  double r = 0;
+  for (const Eigen::Vector3d& v : mesh.vertices) r = std::max(r, v.norm());
+  return r;
+}
+
 std::vector<Eigen::Vector3d> load_point_cloud(const std::string& path) {
   Assimp::Importer importer;
   const aiScene* scene = read_scene(importer, path, 0);

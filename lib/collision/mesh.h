@@ -26,6 +26,11 @@ struct TriangleMesh {
 // not a format Assimp reads, or has no triangle.
 TriangleMesh load_mesh(const std::string& path, const Eigen::Vector3d& scale);
 
+// Axis-aligned bounds of the vertices, in the mesh's frame (the mesh has at least one vertex).
+void mesh_bounds(const TriangleMesh& mesh, Eigen::Vector3d& lower, Eigen::Vector3d& upper);
+// The largest distance of a vertex from the mesh frame's origin: a bounding sphere's radius.
+double farthest_vertex(const TriangleMesh& mesh);
+
 // The vertices of a point cloud file (PLY, ASCII or binary; any file Assimp reads: its
 // vertices). Throws Error naming the file when it cannot be read or has no point; a point
 // that is not finite is an error (`where` names it).

@@ -1,11 +1,11 @@
 #include "lazyboe/collision/mesh_fit.h"
 
-#include <fcl/fcl.h>
-
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <limits>
+
+#include "lazyboe/collision/fcl_shapes.h"
 
 namespace lazyboe {
 namespace {
@@ -141,12 +141,7 @@ double thinnest_extent(const TriangleMesh& mesh) {
 }
 
 double largest_surface_gap(const TriangleMesh& mesh, const Shape& shape, const Pose& in_mesh) {
-  fcl::BVHModel<fcl::OBBRSSd> bvh;
-  std::vector<fcl::Triangle> triangles;
-  for (const Eigen::Vector3i& t : mesh.triangles) triangles.emplace_back(t[0], t[1], t[2]);
-  bvh.beginModel(static_cast<int>(triangles.size()), static_cast<int>(mesh.vertices.size()));
-  bvh.addSubModel(mesh.vertices, triangles);
-  bvh.endModel();
+  const std::shared_ptr<fcl::BVHModel<fcl::OBBRSSd>> bvh = mesh_geometry(mesh);
   const fcl::Sphered point(1e-9);
   fcl::DistanceRequestd request;
   double gap = 0;
@@ -154,7 +149,8 @@ double largest_surface_gap(const TriangleMesh& mesh, const Shape& shape, const P
     fcl::DistanceResultd result;
     fcl::Transform3d at = fcl::Transform3d::Identity();
     at.translation() = p;
-    const double d = fcl::distance(&point, at, &bvh, fcl::Transform3d::Identity(), request, result);
+    const double d =
+        fcl::distance(&point, at, bvh.get(), fcl::Transform3d::Identity(), request, result);
     gap = std::max(gap, d);
   }
   return gap;

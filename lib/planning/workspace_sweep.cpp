@@ -38,8 +38,7 @@ SweptShape swept_shape(const RobotModel& robot, const CollisionBody& cb) {
       s.radius = cb.shape.size.norm() / 2;
       break;
     case ShapeType::Mesh:  // about its bounding box's centre, the shape's frame
-      for (const Eigen::Vector3d& v : cb.shape.mesh->vertices)
-        s.radius = std::max(s.radius, v.norm());
+      s.radius = farthest_vertex(*cb.shape.mesh);
       break;
   }
   s.radius += robot.collision_margin;
