@@ -14,7 +14,9 @@
 #include "lazyboe/common/file_checks.h"
 #include "lazyboe/io/csv.h"
 #include "lazyboe/io/trajectory_csv.h"
+#include "lazyboe/common/json_fields.h"
 #include "lazyboe/robot/dynamics.h"
+#include "lazyboe/robot/payload.h"
 #include "lazyboe/robot/resource_path.h"
 #include "lazyboe/sim/robot_setup.h"
 #include "lazyboe/sim/trajectory_check.h"
@@ -185,7 +187,7 @@ int cmd_info(const RobotModel& robot, bool as_json) {
 int cmd_fk(const RobotModel& robot, const std::string& q_text, const std::string& link_name) {
   const JointVector q = parse_q(q_text, robot);
   const int link = link_name.empty() ? robot.tip_link() : robot.link_index(link_name);
-  if (link < 0) fail("--link", "unknown link '" + link_name + "' (see lazyboe-robot info)");
+  if (link < 0) fail("--link", robot.unknown_link(link_name));
   RobotData data(robot);
   forward_kinematics(robot, data, q);
   const Pose pose = link_pose(robot, data, link);
@@ -311,13 +313,35 @@ std::string check_summary(const TrajectoryCheckResult& r) {
   return text;
 }
 
-int cmd_validate_trajectory(const RobotModel& robot, const std::string& env_path,
-                            const std::string& in) {
+// A task given on the command line as JSON text (--payload, --end-effector-limits), read as a
+// query's field is; `start` sets the default tilt axis.
+JsonField task_field(const std::string& text, const std::string& option, nlohmann::json& doc) {
+  doc = parse_json_text(text, option, false);
+  return JsonField(doc, option, "");
+}
+
+int cmd_validate_trajectory(const RobotModel& bundle_robot, const std::string& env_path,
+                            const std::string& in, const std::string& payload_text,
+                            const std::string& limits_text) {
+  nlohmann::json doc;
+  const Payload payload = payload_text.empty()
+                              ? Payload{}
+                              : payload_from_json(task_field(payload_text, "--payload", doc),
+                                                  bundle_robot);
+  const RobotModel robot = with_payload(bundle_robot, payload);
   const Environment env = load_environment(env_path);
   const CollisionModel cm = build_collision_model(robot, env);
-  const TrajectoryChecker checker(robot, cm);
   const TrajectoryCsv traj = read_trajectory_csv(in, robot.dof);
   if (traj.t.size() < 2) fail(in + ":" + std::to_string(traj.line[0]), "only one sample");
+  TrajectoryCheckOptions options;
+  if (!limits_text.empty()) {
+    RobotData data(robot);
+    options.end_effector =
+        end_effector_limits_from_json(task_field(limits_text, "--end-effector-limits", doc), robot,
+                                      Eigen::Map<const Eigen::VectorXd>(traj.q.data(), robot.dof),
+                                      data);
+  }
+  const TrajectoryChecker checker(robot, cm, options);
   const int bad = first_bad_spacing(checker, traj.view());
   if (bad >= 0) {
     char what[256];
@@ -445,6 +469,11 @@ int main(int argc, char** argv) {
   validate->add_option("--in", in_path, "CSV with header t,q1..qn,dq1..dqn[,more columns]")
       ->required();
   validate->add_option("--env", env_path, "Environment (JSON)")->capture_default_str();
+  std::string payload_text, limits_text;
+  validate->add_option("--payload", payload_text,
+                       "The payload the arm carries, as a query's \"payload\" (JSON text)");
+  validate->add_option("--end-effector-limits", limits_text,
+                       "End-effector limits, as a query's \"end_effector_limits\" (JSON text)");
 
   lazyboe::RobotSetupOptions setup;
   std::string package_path, meshes = "fitted";
@@ -466,7 +495,7 @@ int main(int argc, char** argv) {
     if (*fk) return cmd_fk(robot, q_text, link_name);
     if (*torques) return cmd_torques(robot, in_path, out_path);
     if (*check) return cmd_check(robot, env_path, in_path, out_path);
-    if (*validate) return cmd_validate_trajectory(robot, env_path, in_path);
+    if (*validate) return cmd_validate_trajectory(robot, env_path, in_path, payload_text, limits_text);
     return cmd_allowed_pairs(robot, samples, seed);
   });
 }

@@ -76,7 +76,7 @@ void parse_position_goal(const JsonField& goal, const RobotModel& robot, const Q
   const std::string link =
       goal.has("link") ? goal.at("link").string() : robot.links[robot.tip_link()].name;
   g.link = robot.link_index(link);
-  if (g.link < 0) goal.at("link").fail("unknown link '" + link + "'");
+  if (g.link < 0) goal.at("link").fail(robot.unknown_link(link));
 }
 
 void parse_goal(const JsonField& goal, const RobotModel& robot, const QueryDefaults& d, Goal& g) {
@@ -106,7 +106,9 @@ const std::vector<std::string>& query_fields() {
                                   "scene",
                                   "raw",
                                   "sample_interval",
-                                  "shortcut_attempts"};
+                                  "shortcut_attempts",
+                                  "payload",
+                                  "end_effector_limits"};
     for (const std::string& name : all_parameter_names()) f.push_back(name);
     return f;
   }();
@@ -153,6 +155,19 @@ void parse_problem(const JsonField& root, const Simulator& sim, const QueryDefau
   parse_goal(root.at("goal"), sim.robot, d, p.goal);
 }
 
+// The world with the query's task, when it has one (a payload, end-effector limits).
+WorldPtr parse_task(const JsonField& root, const Simulator& sim, SimulatorWorkspace& ws,
+                    const WorldPtr& world, SceneCache* scenes, const JointVector& start) {
+  if (!root.has("payload") && !root.has("end_effector_limits")) return world;
+  if (!scenes) root.fail("a payload or end-effector limits cannot be given here");
+  Task task;
+  if (root.has("payload")) task.payload = payload_from_json(root.at("payload"), sim.robot);
+  if (root.has("end_effector_limits"))
+    task.end_effector =
+        end_effector_limits_from_json(root.at("end_effector_limits"), sim.robot, start, ws.robot);
+  return scenes->with_task(world ? world : scenes->default_world(), task);
+}
+
 }  // namespace
 
 Query read_query(const nlohmann::json& doc, const std::string& where, const Simulator& sim,
@@ -165,8 +180,9 @@ Query read_query(const nlohmann::json& doc, const std::string& where, const Simu
   parse_planner(root, q.request);
   q.request.output = parse_output(root, d.output);
   q.world = parse_scene(root, scenes);
+  parse_problem(root, q.world ? q.world->sim : sim, d, q.request.problem);
+  q.world = parse_task(root, sim, ws, q.world, scenes, q.request.problem.start);
   const Simulator& in = q.world ? q.world->sim : sim;
-  parse_problem(root, in, d, q.request.problem);
   const ProblemIssue issue = find_problem_issue(in, ws, q.request.problem);
   if (issue.any()) fail(where.empty() ? issue.field : where + ": " + issue.field, issue.what);
   return q;

@@ -42,6 +42,16 @@ ProblemIssue state_issue(const Simulator& sim, SimulatorWorkspace& ws, const std
       return {field, "in self-collision"};
     case RolloutStatus::EnvCollision:
       return {field, "in collision with the environment"};
+    case RolloutStatus::EndEffectorTilt: {
+      const EndEffectorLimits& e = sim.end_effector;
+      char what[200];
+      std::snprintf(what, sizeof what,
+                    "tilts %s's axis %.3g rad from the vertical, more than "
+                    "end_effector_limits.max_tilt %.3g rad",
+                    sim.robot.links[e.link].name.c_str(), end_effector_tilt(sim.robot, ws.robot, e),
+                    e.max_tilt);
+      return {field, what};
+    }
     default:
       return {};
   }

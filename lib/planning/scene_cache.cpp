@@ -18,7 +18,7 @@ WorldPtr SceneCache::inline_scene(const JsonField& scene) {
 
 WorldPtr SceneCache::find(const std::string& identity) {
   for (auto it = recent_.begin(); it != recent_.end(); ++it) {
-    if ((*it)->env.identity != identity) continue;
+    if ((*it)->identity != identity) continue;
     recent_.splice(recent_.begin(), recent_, it);
     return recent_.front();
   }
@@ -33,9 +33,23 @@ WorldPtr SceneCache::world(Environment env) {
   }
   // Built outside the lock (FCL's geometry can take milliseconds); of two threads that built
   // one new scene at once, the first to come back is kept and given to both.
-  auto made = std::make_shared<const PlanningWorld>(robot_, std::move(env), options_, marker_);
+  return keep(std::make_shared<const PlanningWorld>(robot_, std::move(env), options_, marker_));
+}
+
+WorldPtr SceneCache::with_task(const WorldPtr& base, const Task& task) {
+  if (!task.any()) return base;
+  {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    if (WorldPtr known = find(world_identity(base->env.identity, task))) return known;
+  }
+  const auto marks = base->edge_marks;
+  const EdgeMarker same = [marks](const Environment&, const CollisionModel&) { return marks; };
+  return keep(std::make_shared<const PlanningWorld>(robot_, base->env, options_, same, task));
+}
+
+WorldPtr SceneCache::keep(WorldPtr made) {
   const std::lock_guard<std::mutex> lock(mutex_);
-  if (WorldPtr known = find(made->env.identity)) return known;
+  if (WorldPtr known = find(made->identity)) return known;
   recent_.push_front(made);
   if (recent_.size() > capacity_) recent_.pop_back();
   return made;

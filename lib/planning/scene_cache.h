@@ -27,9 +27,13 @@ class SceneCache {
   WorldPtr inline_scene(const JsonField& scene);
   // The world of a parsed environment.
   WorldPtr world(Environment env);
+  // `base`'s scene with a query's task (payload, end-effector limits); `base` itself for none.
+  // It shares `base`'s edge marks (they depend on the scene alone).
+  WorldPtr with_task(const WorldPtr& base, const Task& task);
 
  private:
   WorldPtr find(const std::string& identity);  // moved to the front; null if not kept (locked)
+  WorldPtr keep(WorldPtr made);                // the kept world of made's identity (locked)
 
   const RobotModel& robot_;
   const SimulationOptions options_;

@@ -5,7 +5,9 @@
 // Internal to the planners (not installed).
 #pragma once
 
+#include <array>
 #include <cstdint>
+#include <string>
 #include <functional>
 #include <optional>
 #include <vector>
@@ -81,6 +83,9 @@ class SearchState {
   void count(const RolloutResult& r) {
     ++result_.counters.simulations;
     result_.counters.collision_checks += r.collision_checks;
+    if (r.valid()) ++valid_;
+    const int e = static_cast<int>(r.status) - static_cast<int>(RolloutStatus::EndEffectorSpeed);
+    if (e >= 0 && e < 3) ++end_effector_rejections_[e];
   }
 
   // A real node inside the goal region: a solution. `path_to` gives a node's path.
@@ -105,7 +110,26 @@ class SearchState {
   // The budget has run out, or the caller cancelled the solve.
   bool out_of_time() const { return deadline_.passed() || problem_.termination.cancelled(); }
   bool should_stop() const {
-    return out_of_time() || (problem_.termination.stop_at_first && result_.success);
+    return out_of_time() || (problem_.termination.stop_at_first && result_.success) ||
+           task_hopeless();
+  }
+
+  // A task whose end-effector limits no motion meets (issue 29) is a clear failure, not a
+  // timeout: once the first kTaskHopelessAfter simulations have all broken them.
+  static constexpr uint64_t kTaskHopelessAfter = 200;
+  bool task_hopeless() const {
+    const uint64_t broke = end_effector_rejections_[0] + end_effector_rejections_[1] +
+                           end_effector_rejections_[2];
+    return valid_ == 0 && broke >= kTaskHopelessAfter && broke == result_.counters.simulations;
+  }
+  // Why a solve that stopped without a solution did: the budget, or a hopeless task.
+  std::string stop_failure() const {
+    if (!task_hopeless()) return "no solution within the time budget";
+    const auto& n = end_effector_rejections_;
+    return "no motion meets the end-effector limits: all of the first " +
+           std::to_string(result_.counters.simulations) +
+           " commands simulated broke them (speed " + std::to_string(n[0]) + ", acceleration " +
+           std::to_string(n[1]) + ", tilt " + std::to_string(n[2]) + ")";
   }
 
  private:
@@ -128,6 +152,8 @@ class SearchState {
   RobotData goal_data_;
   std::vector<Node> nodes_;
   PlanResult result_;
+  uint64_t valid_ = 0;  // valid simulations
+  std::array<uint64_t, 3> end_effector_rejections_{};  // by speed, acceleration, tilt
 };
 
 }  // namespace lazyboe

@@ -16,6 +16,7 @@
 #include "lazyboe/collision/collision_model.h"
 #include "lazyboe/collision/environment.h"
 #include "lazyboe/planning/workspace_index.h"
+#include "lazyboe/robot/payload.h"
 #include "lazyboe/sim/simulator.h"
 
 namespace lazyboe {
@@ -26,15 +27,33 @@ namespace lazyboe {
 using EdgeMarker =
     std::function<std::shared_ptr<const EdgeMarks>(const Environment&, const CollisionModel&)>;
 
+// What a query's task adds to the world (issue 29): a payload the arm carries, which changes
+// the dynamics every command is simulated with, and end-effector limits every tick is checked
+// against. The bundle is not rebuilt: its edges are commands, simulated again in this world
+// before any is returned.
+struct Task {
+  Payload payload;
+  EndEffectorLimits end_effector;
+  bool any() const { return payload.any() || end_effector.any(); }
+};
+// A canonical text of the task; empty for none.
+std::string task_identity(const Task& task);
+// What a world of this scene and task is kept by: the scene's identity, then the task's.
+std::string world_identity(const std::string& env_identity, const Task& task);
+
 class PlanningWorld {
  public:
   // Throws Error (naming the environment) when it names a link the robot does not have.
   PlanningWorld(const RobotModel& robot, Environment environment, const SimulationOptions& options,
-                const EdgeMarker& marker = {});
+                const EdgeMarker& marker = {}, const Task& task = {});
   PlanningWorld(const PlanningWorld&) = delete;  // the simulator refers to members
   PlanningWorld& operator=(const PlanningWorld&) = delete;
 
+  const Task task;
+  const RobotModel robot;  // the session's robot, carrying the task's payload
   const Environment env;
+  // The environment's identity and the task's: what the session's scene cache keeps it by.
+  const std::string identity;
   const CollisionModel collision;
   const Simulator sim;
   // The bundle edges this world may block, for the planners' collision prior; null: none known.

@@ -58,4 +58,16 @@ Pose link_pose(const RobotModel& model, const RobotData& data, int link) {
   return l.body < 0 ? l.in_body : data.body_pose[l.body] * l.in_body;
 }
 
+Eigen::Vector3d link_linear_velocity(const RobotModel& model, const RobotData& data, int link,
+                                     const JointVectorRef& dq) {
+  const Eigen::Vector3d p = link_pose(model, data, link).p;
+  Eigen::Vector3d v = Eigen::Vector3d::Zero();
+  for (int i = 0; i <= model.links[link].body; ++i) {
+    const Pose& joint = data.body_pose[i];
+    const Eigen::Vector3d axis = joint.R * model.joints[i].axis;
+    v += dq[i] * (model.joints[i].type == JointType::Prismatic ? axis : axis.cross(p - joint.p));
+  }
+  return v;
+}
+
 }  // namespace lazyboe

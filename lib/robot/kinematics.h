@@ -47,4 +47,9 @@ void forward_kinematics(const RobotModel& model, RobotData& data, const JointVec
 // Pose of a link in the base frame, from the body poses of the last forward_kinematics.
 Pose link_pose(const RobotModel& model, const RobotData& data, int link);
 
+// Linear velocity of a link's origin in the base frame for joint velocities dq, from the body
+// poses of the last forward_kinematics (the geometric Jacobian's upper rows times dq).
+Eigen::Vector3d link_linear_velocity(const RobotModel& model, const RobotData& data, int link,
+                                     const JointVectorRef& dq);
+
 }  // namespace lazyboe

@@ -21,6 +21,7 @@
 #include "lazyboe/common/file_checks.h"
 #include "lazyboe/common/json_fields.h"
 #include "lazyboe/common/numbers.h"
+#include "lazyboe/common/text.h"
 #include "lazyboe/robot/dynamics.h"
 #include "lazyboe/robot/kinematics.h"
 #include "lazyboe/robot/urdf_check.h"
@@ -200,6 +201,16 @@ const char* shape_type_name(ShapeType type) {
 
 const char* mesh_representation_name(MeshRepresentation representation) {
   return representation == MeshRepresentation::Exact ? "exact" : "fitted";
+}
+
+std::string RobotModel::unknown_link(const std::string& link_name) const {
+  std::vector<std::string> names;
+  for (const Link& l : links) names.push_back(l.name);
+  const std::string close = did_you_mean(link_name, names);
+  if (!close.empty()) return "unknown link '" + link_name + "'" + close;
+  std::string text = "unknown link '" + link_name + "' (the links: ";
+  for (size_t i = 0; i < names.size(); ++i) text += (i ? ", " : "") + names[i];
+  return text + ")";
 }
 
 int RobotModel::link_index(const std::string& link_name) const {

@@ -136,6 +136,8 @@ struct RobotModel {
   JointVector q_min, q_max, dq_max, ddq_max, dddq_max, tau_max, dtau_max;
 
   int link_index(const std::string& link_name) const;  // -1 when unknown
+  // "unknown link 'x'" with the closest name ("did you mean") or else the links there are.
+  std::string unknown_link(const std::string& link_name) const;
   int tip_link() const { return static_cast<int>(links.size()) - 1; }
   bool is_allowed_pair(int link_a, int link_b) const;
 };

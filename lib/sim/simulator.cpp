@@ -29,6 +29,12 @@ const char* rollout_status_name(RolloutStatus status) {
       return "env_collision";
     case RolloutStatus::NotSettled:
       return "not_settled";
+    case RolloutStatus::EndEffectorSpeed:
+      return "end_effector_speed";
+    case RolloutStatus::EndEffectorAcceleration:
+      return "end_effector_acceleration";
+    case RolloutStatus::EndEffectorTilt:
+      return "end_effector_tilt";
   }
   return "?";
 }
@@ -91,10 +97,11 @@ bool within(const JointVector& value, const JointVector& bound) {
 }  // namespace
 
 Simulator::Simulator(const RobotModel& robot_model, const CollisionModel& collision_model,
-                     SimulationOptions opts)
+                     SimulationOptions opts, EndEffectorLimits end_effector_limits)
     : robot(robot_model),
       collision(collision_model),
       options(opts),
+      end_effector(end_effector_limits),
       dt(1.0 / robot_model.control_rate),
       lever_arm(collision_lever_arms(robot_model, collision_model)) {
   if (!robot.controller.present) {
@@ -116,6 +123,9 @@ RolloutStatus check_state(const Simulator& sim, SimulatorWorkspace& ws, const Jo
   const CollisionReport report = check_collision(sim.collision, ws.collision);
   if (report.env_collision) return RolloutStatus::EnvCollision;
   if (report.self_collision) return RolloutStatus::SelfCollision;
+  if (sim.end_effector.any() &&
+      !(end_effector_tilt(robot, ws.robot, sim.end_effector) <= sim.end_effector.max_tilt))
+    return RolloutStatus::EndEffectorTilt;
   return RolloutStatus::Valid;
 }
 
@@ -261,6 +271,40 @@ bool can_stop_dead(const RobotModel& robot, const RobotData& rd, const JointVect
   return RolloutStatus::Valid;
 }
 
+// The limited link's velocity at each tick and its change over the tick (a task's end-effector
+// limits; nothing when it has none). Before the rollout the arm is at rest.
+class EndEffectorTrack {
+ public:
+  explicit EndEffectorTrack(const Simulator& sim, RobotData& rd)
+      : sim_(sim), limits_(sim.end_effector), rd_(rd) {}
+  // The state reached by a tick: its speed, acceleration (on the first tick, half the limit:
+  // the other half is the previous rollout's last tick) and tilt.
+  RolloutStatus step(const JointVector& q, const JointVector& dq, bool first) {
+    if (!limits_.any()) return RolloutStatus::Valid;
+    forward_kinematics(sim_.robot, rd_, q);
+    const Eigen::Vector3d v = link_linear_velocity(sim_.robot, rd_, limits_.link, dq);
+    const double acceleration = (v - v_).norm() / sim_.dt;
+    v_ = v;
+    if (!(v.norm() <= limits_.max_linear_speed)) return RolloutStatus::EndEffectorSpeed;
+    if (!(acceleration <= (first ? 0.5 : 1.0) * limits_.max_linear_acceleration))
+      return RolloutStatus::EndEffectorAcceleration;
+    if (!(end_effector_tilt(sim_.robot, rd_, limits_) <= limits_.max_tilt))
+      return RolloutStatus::EndEffectorTilt;
+    return RolloutStatus::Valid;
+  }
+  // Stopping here: the next rollout starts from rest, a change of velocity from v_ to 0 within
+  // a tick; half the acceleration limit for that.
+  bool can_rest() const {
+    return !limits_.any() || v_.norm() / sim_.dt <= 0.5 * limits_.max_linear_acceleration;
+  }
+
+ private:
+  const Simulator& sim_;
+  const EndEffectorLimits& limits_;
+  RobotData& rd_;
+  Eigen::Vector3d v_ = Eigen::Vector3d::Zero();
+};
+
 }  // namespace
 
 RolloutResult simulate(const Simulator& sim, SimulatorWorkspace& ws, const JointVectorRef& q0_in,
@@ -295,6 +339,7 @@ RolloutResult simulate(const Simulator& sim, SimulatorWorkspace& ws, const Joint
   ++result.collision_checks;
   if (start != RolloutStatus::Valid) return finish(start, 0);
   push_sample(samples, q, dq);
+  EndEffectorTrack end_effector(sim, rd);
 
   const int max_ticks =
       static_cast<int>(std::ceil((profile.duration + sim.options.max_settle_time) / dt));
@@ -312,7 +357,8 @@ RolloutResult simulate(const Simulator& sim, SimulatorWorkspace& ws, const Joint
     tau_prev = tau;
 
     // Stop once at rest after the command (the last motion collision-checked).
-    if (t >= profile.duration && at_rest(sim, rd, dq, ddq_prev, tau, ddq_step_max, tau_rate_max)) {
+    if (t >= profile.duration && at_rest(sim, rd, dq, ddq_prev, tau, ddq_step_max, tau_rate_max) &&
+        end_effector.can_rest()) {
       if (moved > 0) {
         const RolloutStatus c = collision_status(sim, ws, q, result.collision_checks);
         if (c != RolloutStatus::Valid) return finish(c, tick);
@@ -331,6 +377,8 @@ RolloutResult simulate(const Simulator& sim, SimulatorWorkspace& ws, const Joint
     ddq_prev = ddq;
     const RolloutStatus limits = state_limits(robot, q, dq);
     if (limits != RolloutStatus::Valid) return finish(limits, tick + 1);
+    const RolloutStatus task = end_effector.step(q, dq, tick == 0);
+    if (task != RolloutStatus::Valid) return finish(task, tick + 1);
 
     result.path_length += (q - q_prev).norm();
     const RolloutStatus c = check_motion(sim, ws, q_prev, q, moved, k.k1q, result.collision_checks);

@@ -15,6 +15,7 @@
 
 #include "lazyboe/collision/collision_model.h"
 #include "lazyboe/robot/dynamics.h"
+#include "lazyboe/sim/end_effector.h"
 #include "lazyboe/sim/command_profile.h"
 
 namespace lazyboe {
@@ -30,8 +31,11 @@ enum class RolloutStatus : uint8_t {
   SelfCollision,
   EnvCollision,
   NotSettled,
+  EndEffectorSpeed,
+  EndEffectorAcceleration,
+  EndEffectorTilt,
 };
-constexpr int kRolloutStatusCount = 10;
+constexpr int kRolloutStatusCount = 13;
 const char* rollout_status_name(RolloutStatus status);
 
 // RK4: 4th order, 4 forward-dynamics evaluations per step. SemiImplicitEuler: 1st order and
@@ -72,11 +76,13 @@ int exact_sample_every_ticks(double interval_s, double control_rate, const std::
 JointVector collision_lever_arms(const RobotModel& robot, const CollisionModel& collision);
 
 struct Simulator {
-  Simulator(const RobotModel& robot, const CollisionModel& collision, SimulationOptions options);
+  Simulator(const RobotModel& robot, const CollisionModel& collision, SimulationOptions options,
+            EndEffectorLimits end_effector = {});
 
   const RobotModel& robot;
   const CollisionModel& collision;
   SimulationOptions options;
+  EndEffectorLimits end_effector;  // a task's, checked at every tick when any()
   double dt;              // control period, s
   JointVector lever_arm;  // per joint: bound on any robot point's motion per unit joint motion
 };

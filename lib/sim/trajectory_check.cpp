@@ -29,6 +29,12 @@ const char* trajectory_limit_name(TrajectoryLimit limit) {
       return "self_collision";
     case TrajectoryLimit::EnvCollision:
       return "env_collision";
+    case TrajectoryLimit::EndEffectorSpeed:
+      return "end_effector_speed";
+    case TrajectoryLimit::EndEffectorAcceleration:
+      return "end_effector_acceleration";
+    case TrajectoryLimit::EndEffectorTilt:
+      return "end_effector_tilt";
   }
   return "?";
 }
@@ -85,6 +91,7 @@ class Scan {
     for (int k = 0; k <= last; ++k) {
       if (k > 0 && o_.check_collision && motion_collides(k)) return;
       if (sample_violates(k)) return;
+      if (o_.end_effector.any() && end_effector_violates(k)) return;
       if (period_violates(k)) return;
       if (k == 0 && o_.check_collision && collides_at(0, 0.0, q(0))) return;
     }
@@ -216,6 +223,37 @@ class Scan {
     return false;
   }
 
+  // The end-effector limits at sample k: its speed and tilt, and its velocity change since the
+  // previous sample (from rest before the first) and, after the last, back to rest. The
+  // allowance: how far rounding of dq by the sample precision moves the velocity.
+  bool end_effector_violates(int k) {
+    const EndEffectorLimits& e = o_.end_effector;
+    const double u = o_.sample_precision, dt = checker_.dt;
+    RobotData& rd = ws_.robot;
+    forward_kinematics(robot_, rd, q(k));
+    const Eigen::Vector3d v = link_linear_velocity(robot_, rd, e.link, dq(k));
+    const double v_err = u * checker_.lever_arm.dot(dq(k).cwiseAbs());
+    if (end_effector_over(TrajectoryLimit::EndEffectorSpeed, k, v.norm(), e.max_linear_speed,
+                          v_err) ||
+        end_effector_over(TrajectoryLimit::EndEffectorAcceleration, k, (v - v_prev_).norm() / dt,
+                          e.max_linear_acceleration, (v_err + v_err_prev_) / dt) ||
+        end_effector_over(TrajectoryLimit::EndEffectorTilt, k, end_effector_tilt(robot_, rd, e),
+                          e.max_tilt, u * q(k).cwiseAbs().sum()))
+      return true;
+    v_prev_ = v;
+    v_err_prev_ = v_err;
+    return k == traj_.samples - 1 &&
+           end_effector_over(TrajectoryLimit::EndEffectorAcceleration, k, v.norm() / dt,
+                             e.max_linear_acceleration, v_err / dt);
+  }
+
+  bool end_effector_over(TrajectoryLimit limit, int k, double value, double bound,
+                         double allowance) {
+    if (value <= bound + allowance) return false;
+    violate(limit, k, time(k), -1, value, bound);
+    return true;
+  }
+
   // Collision of configuration x, checked at time t(k) + dt_after.
   bool collides_at(int k, double dt_after, const JointVectorRef& x) {
     ++result.collision_checks;
@@ -267,6 +305,8 @@ class Scan {
   JointVector a_prev_, a_err_prev_, tau_prev_, tau_err_prev_;
   JointVector mid_q_, mid_dq_, between_;
   double moved_ = 0;
+  Eigen::Vector3d v_prev_ = Eigen::Vector3d::Zero();  // end-effector velocity, previous sample
+  double v_err_prev_ = 0;
 };
 
 }  // namespace
@@ -309,6 +349,12 @@ const char* unit(TrajectoryLimit limit) {
       return "Nm";
     case TrajectoryLimit::TorqueRate:
       return "Nm/s";
+    case TrajectoryLimit::EndEffectorSpeed:
+      return "m/s";
+    case TrajectoryLimit::EndEffectorAcceleration:
+      return "m/s^2";
+    case TrajectoryLimit::EndEffectorTilt:
+      return "rad from the vertical";
     default:
       return "m";
   }
@@ -323,6 +369,12 @@ std::string describe_violation(const TrajectoryChecker& checker, const Trajector
   char tail[192];
   const bool collision =
       v.limit == TrajectoryLimit::SelfCollision || v.limit == TrajectoryLimit::EnvCollision;
+  if (v.joint < 0 && !collision) {  // an end-effector limit
+    std::snprintf(tail, sizeof tail, "%s %.6g %s, limit %.6g",
+                  checker.robot.links[checker.options.end_effector.link].name.c_str(), v.value,
+                  unit(v.limit), v.bound);
+    return std::string(head) + tail;
+  }
   if (!collision) {
     std::snprintf(tail, sizeof tail, "joint %d (%s) %.6g %s, limit %.6g", v.joint + 1,
                   checker.robot.joints[v.joint].name.c_str(), v.value, unit(v.limit), v.bound);

@@ -30,8 +30,14 @@ enum class TrajectoryLimit : uint8_t {
   EndAtRest,     // |dq| of the last sample
   SelfCollision,
   EnvCollision,
+  // A task's end-effector limits (options.end_effector), as the simulator checks them: the
+  // link's linear speed at each sample (Jacobian times dq), the change of that velocity between
+  // samples / dt (from and back to rest), the tilt of its axis from the vertical.
+  EndEffectorSpeed,
+  EndEffectorAcceleration,
+  EndEffectorTilt,
 };
-constexpr int kTrajectoryLimitCount = 10;
+constexpr int kTrajectoryLimitCount = 13;
 // The per-joint limits (Position .. TorqueRate), which have a peak fraction.
 constexpr int kJointLimitCount = 6;
 const char* trajectory_limit_name(TrajectoryLimit limit);
@@ -55,6 +61,7 @@ struct TrajectoryCheckOptions {
   // |t_{k+1} - t_k - dt| allowed, s (t written with 10 significant digits).
   double time_tolerance = 1e-6;
   bool check_collision = true;
+  EndEffectorLimits end_effector;  // none by default
 };
 
 struct TrajectoryViolation {

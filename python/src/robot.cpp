@@ -34,7 +34,7 @@ int link_of(const RobotModel& m, const py::object& link) {
   if (!py::isinstance<py::str>(link)) throw InputError("link: expected a link name");
   const std::string name = link.cast<std::string>();
   const int k = m.link_index(name);
-  if (k < 0) throw InputError("link: unknown link '" + name + "'");
+  if (k < 0) throw InputError("link: " + m.unknown_link(name));
   return k;
 }
 

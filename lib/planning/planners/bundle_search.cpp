@@ -91,7 +91,7 @@ PlanResult BundleSearch::run() {
   PlanResult& r = s_.result();
   if (!r.success && r.failure.empty()) {
     r.failure = open_.empty() ? "search exhausted: no more nodes to expand within the bundle"
-                              : "no solution within the time budget";
+                              : s_.stop_failure();
   }
   return r;
 }

@@ -162,7 +162,7 @@ PlanResult LazySpSearch::run() {
     }
   }
   PlanResult& r = s_.result();
-  if (!r.success) r.failure = "no solution within the time budget";
+  if (!r.success) r.failure = s_.stop_failure();
   return r;
 }
 

@@ -57,7 +57,7 @@ PlanResult TreeSearch::run() {
     }
   }
   PlanResult& result = s_.result();
-  if (!result.success) result.failure = "no solution within the time budget";
+  if (!result.success) result.failure = s_.stop_failure();
   return result;
 }
 
