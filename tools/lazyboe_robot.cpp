@@ -12,9 +12,9 @@
 #include "lazyboe/collision/collision_model.h"
 #include "lazyboe/common/atomic_file.h"
 #include "lazyboe/common/file_checks.h"
+#include "lazyboe/common/json_fields.h"
 #include "lazyboe/io/csv.h"
 #include "lazyboe/io/trajectory_csv.h"
-#include "lazyboe/common/json_fields.h"
 #include "lazyboe/robot/dynamics.h"
 #include "lazyboe/robot/payload.h"
 #include "lazyboe/robot/resource_path.h"
@@ -324,10 +324,10 @@ int cmd_validate_trajectory(const RobotModel& bundle_robot, const std::string& e
                             const std::string& in, const std::string& payload_text,
                             const std::string& limits_text) {
   nlohmann::json doc;
-  const Payload payload = payload_text.empty()
-                              ? Payload{}
-                              : payload_from_json(task_field(payload_text, "--payload", doc),
-                                                  bundle_robot);
+  const Payload payload =
+      payload_text.empty()
+          ? Payload{}
+          : payload_from_json(task_field(payload_text, "--payload", doc), bundle_robot);
   const RobotModel robot = with_payload(bundle_robot, payload);
   const Environment env = load_environment(env_path);
   const CollisionModel cm = build_collision_model(robot, env);
@@ -336,10 +336,9 @@ int cmd_validate_trajectory(const RobotModel& bundle_robot, const std::string& e
   TrajectoryCheckOptions options;
   if (!limits_text.empty()) {
     RobotData data(robot);
-    options.end_effector =
-        end_effector_limits_from_json(task_field(limits_text, "--end-effector-limits", doc), robot,
-                                      Eigen::Map<const Eigen::VectorXd>(traj.q.data(), robot.dof),
-                                      data);
+    options.end_effector = end_effector_limits_from_json(
+        task_field(limits_text, "--end-effector-limits", doc), robot,
+        Eigen::Map<const Eigen::VectorXd>(traj.q.data(), robot.dof), data);
   }
   const TrajectoryChecker checker(robot, cm, options);
   const int bad = first_bad_spacing(checker, traj.view());
@@ -495,7 +494,8 @@ int main(int argc, char** argv) {
     if (*fk) return cmd_fk(robot, q_text, link_name);
     if (*torques) return cmd_torques(robot, in_path, out_path);
     if (*check) return cmd_check(robot, env_path, in_path, out_path);
-    if (*validate) return cmd_validate_trajectory(robot, env_path, in_path, payload_text, limits_text);
+    if (*validate)
+      return cmd_validate_trajectory(robot, env_path, in_path, payload_text, limits_text);
     return cmd_allowed_pairs(robot, samples, seed);
   });
 }

@@ -160,6 +160,9 @@ Trajectory returned_trajectory(const Simulator& sim, SimulatorWorkspace& ws,
 Simulator execution_simulator(const Simulator& sim) {
   Simulator stopping = sim;
   stopping.options.settle_for_stop = true;
+  // Settling for a dead stop takes longer than the planners' settle, the more so with a payload
+  // (a 3 kg load 30 cm out from the Panda's flange needed up to 0.9 s more, issue 29).
+  stopping.options.max_settle_time = std::max(sim.options.max_settle_time, kExecutionSettleTime);
   return stopping;
 }
 

@@ -96,7 +96,9 @@ ExecutableTrajectory make_executable(const Simulator& sim, SimulatorWorkspace& w
 // The simulator of the returned segments that end at a kept stop: `sim` with settle_for_stop,
 // since the next segment starts from exactly zero velocity, so the arm must be able to stop
 // dead there. The last segment, after which the arm holds its position under the controller,
-// and the raw chain keep `sim`'s settle, as the planners simulated them.
+// and the raw chain keep `sim`'s settle, as the planners simulated them. It may settle for up
+// to kExecutionSettleTime after the command.
+constexpr double kExecutionSettleTime = 3.0;  // s
 Simulator execution_simulator(const Simulator& sim);
 
 // What answer_request (request.h) returns for a solved problem: the

@@ -7,9 +7,9 @@
 
 #include <array>
 #include <cstdint>
-#include <string>
 #include <functional>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "lazyboe/planning/execution.h"
@@ -118,8 +118,8 @@ class SearchState {
   // timeout: once the first kTaskHopelessAfter simulations have all broken them.
   static constexpr uint64_t kTaskHopelessAfter = 200;
   bool task_hopeless() const {
-    const uint64_t broke = end_effector_rejections_[0] + end_effector_rejections_[1] +
-                           end_effector_rejections_[2];
+    const uint64_t broke =
+        end_effector_rejections_[0] + end_effector_rejections_[1] + end_effector_rejections_[2];
     return valid_ == 0 && broke >= kTaskHopelessAfter && broke == result_.counters.simulations;
   }
   // Why a solve that stopped without a solution did: the budget, or a hopeless task.
@@ -127,9 +127,9 @@ class SearchState {
     if (!task_hopeless()) return "no solution within the time budget";
     const auto& n = end_effector_rejections_;
     return "no motion meets the end-effector limits: all of the first " +
-           std::to_string(result_.counters.simulations) +
-           " commands simulated broke them (speed " + std::to_string(n[0]) + ", acceleration " +
-           std::to_string(n[1]) + ", tilt " + std::to_string(n[2]) + ")";
+           std::to_string(result_.counters.simulations) + " commands simulated broke them (speed " +
+           std::to_string(n[0]) + ", acceleration " + std::to_string(n[1]) + ", tilt " +
+           std::to_string(n[2]) + ")";
   }
 
  private:
@@ -152,7 +152,7 @@ class SearchState {
   RobotData goal_data_;
   std::vector<Node> nodes_;
   PlanResult result_;
-  uint64_t valid_ = 0;  // valid simulations
+  uint64_t valid_ = 0;                                 // valid simulations
   std::array<uint64_t, 3> end_effector_rejections_{};  // by speed, acceleration, tilt
 };
 

@@ -71,9 +71,10 @@ std::string payload_identity(const Payload& p) {
   if (!p.any()) return "";
   char text[512];
   const Eigen::Matrix3d& I = p.inertia;
-  std::snprintf(text, sizeof text, "payload %d %.17g [%.17g %.17g %.17g] [%.17g %.17g %.17g %.17g %.17g %.17g]",
-                p.link, p.mass, p.com.x(), p.com.y(), p.com.z(), I(0, 0), I(0, 1), I(0, 2),
-                I(1, 1), I(1, 2), I(2, 2));
+  std::snprintf(text, sizeof text,
+                "payload %d %.17g [%.17g %.17g %.17g] [%.17g %.17g %.17g %.17g %.17g %.17g]",
+                p.link, p.mass, p.com.x(), p.com.y(), p.com.z(), I(0, 0), I(0, 1), I(0, 2), I(1, 1),
+                I(1, 2), I(2, 2));
   return text;
 }
 

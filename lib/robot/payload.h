@@ -13,11 +13,11 @@ namespace lazyboe {
 class JsonField;
 
 struct Payload {
-  int link = -1;  // the link it is fixed to (index into RobotModel::links); -1: no payload
+  int link = -1;    // the link it is fixed to (index into RobotModel::links); -1: no payload
   double mass = 0;  // kg
-  Eigen::Vector3d com = Eigen::Vector3d::Zero();          // centre of mass, link frame, m
-  Eigen::Matrix3d inertia = Eigen::Matrix3d::Zero();      // about the centre of mass, kg m^2
-  Eigen::Vector3d box = Eigen::Vector3d::Zero();          // its extents when given as a box
+  Eigen::Vector3d com = Eigen::Vector3d::Zero();      // centre of mass, link frame, m
+  Eigen::Matrix3d inertia = Eigen::Matrix3d::Zero();  // about the centre of mass, kg m^2
+  Eigen::Vector3d box = Eigen::Vector3d::Zero();      // its extents when given as a box
   bool any() const { return link >= 0; }
 };
 

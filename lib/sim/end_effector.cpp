@@ -27,8 +27,7 @@ EndEffectorLimits end_effector_limits_from_json(const JsonField& f, const RobotM
   if (f.has("max_linear_speed"))
     e.max_linear_speed = f.at("max_linear_speed").number_in({0, 1e3, true}, " m/s");
   if (f.has("max_linear_acceleration"))
-    e.max_linear_acceleration =
-        f.at("max_linear_acceleration").number_in({0, 1e4, true}, " m/s^2");
+    e.max_linear_acceleration = f.at("max_linear_acceleration").number_in({0, 1e4, true}, " m/s^2");
   if (f.has("max_tilt")) e.max_tilt = f.at("max_tilt").number_in({0, M_PI}, " rad");
   if (f.has("axis")) {
     const Eigen::Vector3d a = f.at("axis").vec3_in({-1e3, 1e3});

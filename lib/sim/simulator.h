@@ -15,8 +15,8 @@
 
 #include "lazyboe/collision/collision_model.h"
 #include "lazyboe/robot/dynamics.h"
-#include "lazyboe/sim/end_effector.h"
 #include "lazyboe/sim/command_profile.h"
+#include "lazyboe/sim/end_effector.h"
 
 namespace lazyboe {
 
@@ -83,7 +83,7 @@ struct Simulator {
   const CollisionModel& collision;
   SimulationOptions options;
   EndEffectorLimits end_effector;  // a task's, checked at every tick when any()
-  double dt;              // control period, s
+  double dt;                       // control period, s
   JointVector lever_arm;  // per joint: bound on any robot point's motion per unit joint motion
 };
 
