@@ -409,4 +409,19 @@ bool self_pair_collides(const CollisionModel& model, CollisionData& data, int sh
   return self_collides(*model.shapes, data, shape_a, shape_b);
 }
 
+int obstacle_at(const CollisionModel& model, CollisionData& data, const Eigen::Vector3d& point) {
+  const fcl::Sphered dot(1e-6);
+  fcl::Transform3d at = fcl::Transform3d::Identity();
+  at.translation() = point;
+  for (size_t o = 0; o < model.obstacles.size(); ++o) {
+    const CollisionModel::ObstacleShape& shape = model.obstacles[o];
+    if ((point.array() < shape.box_min.array()).any() ||
+        (point.array() > shape.box_max.array()).any())
+      continue;
+    if (collide_with_bvh(data, &dot, at, model.shapes->obstacles[o].geometry, shape.transform))
+      return static_cast<int>(o);
+  }
+  return -1;
+}
+
 }  // namespace lazyboe

@@ -113,4 +113,8 @@ DistanceReport min_distance(const CollisionModel& model, CollisionData& data);
 // Collision of one specific pair (used by the allowed-pair derivation).
 bool self_pair_collides(const CollisionModel& model, CollisionData& data, int shape_a, int shape_b);
 
+// The obstacle whose solid holds `point` (base frame), or -1: for goals inside an obstacle.
+// Meshes are surfaces, so only their surface counts for them.
+int obstacle_at(const CollisionModel& model, CollisionData& data, const Eigen::Vector3d& point);
+
 }  // namespace lazyboe

@@ -79,17 +79,68 @@ void parse_position_goal(const JsonField& goal, const RobotModel& robot, const Q
   if (g.link < 0) goal.at("link").fail(robot.unknown_link(link));
 }
 
+Eigen::Vector3d unit_vector(const JsonField& f) {
+  const Eigen::Vector3d v = f.vec3_in({-1e3, 1e3});
+  if (!(v.norm() > 1e-9)) f.fail("must not be zero");
+  return v.normalized();
+}
+
+// {"pose": {"position", "orientation": [w, x, y, z], "free_axis", "link"},
+// "position_tolerance", "orientation_tolerance"}
+void parse_pose_goal(const JsonField& goal, const RobotModel& robot, const QueryDefaults& d,
+                     Goal& g) {
+  goal.allow_only({"pose", "position_tolerance", "orientation_tolerance"});
+  const JsonField pose = goal.at("pose");
+  pose.allow_only({"position", "orientation", "free_axis", "link"});
+  g.kind = Goal::Kind::Pose;
+  g.position = pose.at("position").vec3_in({-100, 100}, " m");
+  const JsonField o = pose.at("orientation");
+  const std::vector<double> wxyz = o.numbers();
+  if (wxyz.size() != 4) o.fail("expected a quaternion [w, x, y, z]");
+  const Eigen::Quaterniond quaternion(wxyz[0], wxyz[1], wxyz[2], wxyz[3]);
+  if (!(quaternion.norm() > 1e-9)) o.fail("a quaternion of norm 0");
+  g.orientation = quaternion.normalized();
+  if (pose.has("free_axis")) {
+    g.has_free_axis = true;
+    g.free_axis = unit_vector(pose.at("free_axis"));
+  }
+  const std::string link =
+      pose.has("link") ? pose.at("link").string() : robot.links[robot.tip_link()].name;
+  g.link = robot.link_index(link);
+  if (g.link < 0) pose.at("link").fail(robot.unknown_link(link));
+  g.tolerance = goal.has("position_tolerance")
+                    ? goal.at("position_tolerance").number_in({0, 100, true}, " m")
+                    : d.pose_position_tolerance;
+  g.orientation_tolerance =
+      goal.has("orientation_tolerance")
+          ? goal.at("orientation_tolerance").number_in({0, M_PI, true}, " rad")
+          : d.orientation_tolerance;
+}
+
 void parse_goal(const JsonField& goal, const RobotModel& robot, const QueryDefaults& d, Goal& g) {
-  if (goal.has("q")) {
+  if (goal.value().is_array()) {  // a goal set: any member will do
+    g.kind = Goal::Kind::Set;
+    for (const JsonField& member : goal.items()) {
+      if (member.value().is_array()) member.fail("a goal set's members are single goals");
+      g.members.emplace_back();
+      parse_goal(member, robot, d, g.members.back());
+    }
+    if (g.members.empty()) goal.fail("an empty goal set");
+    g.tolerance = g.members[0].tolerance;
+  } else if (goal.has("q")) {
     goal.allow_only({"q", "tolerance"});
     g.kind = Goal::Kind::Joint;
     g.q = joint_vector(goal.at("q"), robot.dof);
     g.tolerance = goal.has("tolerance") ? goal.at("tolerance").number_in({0, 1e3, true}, " rad")
                                         : d.joint_tolerance;
+  } else if (goal.has("pose")) {
+    parse_pose_goal(goal, robot, d, g);
   } else if (goal.has("position")) {
     parse_position_goal(goal, robot, d, g);
   } else {
-    goal.fail("expected \"q\" (joint goal) or \"position\" (end-effector goal)");
+    goal.fail(
+        "expected \"q\" (joint goal), \"pose\" (link pose goal), \"position\" (link position "
+        "goal) or a list of goals (any of them)");
   }
 }
 
@@ -183,6 +234,8 @@ Query read_query(const nlohmann::json& doc, const std::string& where, const Simu
   parse_problem(root, q.world ? q.world->sim : sim, d, q.request.problem);
   q.world = parse_task(root, sim, ws, q.world, scenes, q.request.problem.start);
   const Simulator& in = q.world ? q.world->sim : sim;
+  PlanningProblem& p = q.request.problem;
+  if (needs_configurations(p.goal)) resolve_goal(in, ws, p.start, p.seed, p.goal);
   const ProblemIssue issue = find_problem_issue(in, ws, q.request.problem);
   if (issue.any()) fail(where.empty() ? issue.field : where + ": " + issue.field, issue.what);
   return q;

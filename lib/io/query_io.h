@@ -28,6 +28,8 @@ struct QueryDefaults {
   double budget = 5.0;
   double joint_tolerance = 0.1;
   double position_tolerance = 0.02;
+  double pose_position_tolerance = 0.01;  // m, of a pose goal
+  double orientation_tolerance = 0.05;    // rad, of a pose goal
   ReturnOptions output;  // raw, sample_interval, shortcut_attempts (a tool's flags)
 };
 

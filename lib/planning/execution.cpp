@@ -508,21 +508,39 @@ ExecutableTrajectory make_executable(const Simulator& sim, SimulatorWorkspace& w
   return out;
 }
 
-std::optional<PathStep> direct_step(const Simulator& sim, SimulatorWorkspace& ws,
-                                    const CommandSampling& limits, const PlanningProblem& problem) {
-  const Goal& goal = problem.goal;
-  if (goal.kind != Goal::Kind::Joint) return std::nullopt;
+std::optional<PathStep> direct_step_to(const Simulator& sim, SimulatorWorkspace& ws,
+                                       const CommandSampling& limits, const JointVectorRef& from,
+                                       const JointVector& target, const Goal* land_in,
+                                       int* simulations) {
   std::vector<double> times;
   PathStep step;
-  if (!direct_command(sim.robot, limits, goal.q - problem.start, sim.dt, times, step.knots))
+  if (!direct_command(sim.robot, limits, target - from, sim.dt, times, step.knots))
     return std::nullopt;
   // Evenly spaced knots (times[j] = j h), simulated as such: as a path step is.
   step.command_duration = times.back();
-  const CommandProfile profile{step.knots.data(), static_cast<int>(times.size()), sim.robot.dof,
-                               step.command_duration};
-  step.outcome =
-      simulate(sim, ws, problem.start, profile, {nullptr, nullptr, 0, &step.outcome_rows});
-  return step;
+  const int last = static_cast<int>(times.size()) - 1;
+  for (int round = 0;; ++round) {
+    const CommandProfile profile{step.knots.data(), static_cast<int>(times.size()), sim.robot.dof,
+                                 step.command_duration};
+    step.outcome_rows.clear();
+    step.outcome = simulate(sim, ws, from, profile, {nullptr, nullptr, 0, &step.outcome_rows});
+    if (simulations) *simulations = round + 1;
+    if (!land_in || round >= kDirectCorrections || !step.outcome->valid() ||
+        land_in->contains(sim.robot, ws.robot, step.outcome->qf))
+      return step;
+    correct_command(times, step.knots, 1, last, target - step.outcome->qf);
+  }
+}
+
+std::optional<PathStep> direct_step(const Simulator& sim, SimulatorWorkspace& ws,
+                                    const CommandSampling& limits, const PlanningProblem& problem,
+                                    int* simulations) {
+  const Goal& goal = problem.goal;
+  if (goal.kind == Goal::Kind::Joint)
+    return direct_step_to(sim, ws, limits, problem.start, goal.q, nullptr, simulations);
+  if (goal.configurations.empty()) return std::nullopt;
+  return direct_step_to(sim, ws, limits, problem.start, goal.configurations.front(), &goal,
+                        simulations);
 }
 
 bool solves(const Simulator& sim, SimulatorWorkspace& ws, const PathStep& step, const Goal& goal) {

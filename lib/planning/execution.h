@@ -116,12 +116,22 @@ bool direct_command(const RobotModel& robot, const CommandSampling& limits,
                     const JointVectorRef& displacement, double dt, std::vector<double>& times,
                     std::vector<double>& knots);
 
-// The direct command from the problem's start to its joint goal (direct_command within
-// `limits`), simulated with every check from the start with `sim`'s settle: the step with that
-// simulation as its outcome (valid or not) and its per-tick rows. None for a position goal (no
-// joint target to aim at) or a goal at the start.
+// The direct command from the problem's start to its joint goal, or to the configuration of a
+// pose goal or goal set nearest the start (direct_command within `limits`), simulated with every
+// check from the start with `sim`'s settle: the step with that simulation as its outcome (valid
+// or not) and its per-tick rows. A configuration of a pose goal is a point to land near: when
+// the command lands outside the goal it is corrected by the miss and simulated again, up to
+// kDirectCorrections times. `simulations` (when given) gets how many it ran. None for a
+// position goal (no joint target to aim at) or a goal at the start.
+constexpr int kDirectCorrections = 3;
+// The same from `from` to `target`; corrected while it lands outside `land_in` (null: never).
+std::optional<PathStep> direct_step_to(const Simulator& sim, SimulatorWorkspace& ws,
+                                       const CommandSampling& limits, const JointVectorRef& from,
+                                       const JointVector& target, const Goal* land_in,
+                                       int* simulations = nullptr);
 std::optional<PathStep> direct_step(const Simulator& sim, SimulatorWorkspace& ws,
-                                    const CommandSampling& limits, const PlanningProblem& problem);
+                                    const CommandSampling& limits, const PlanningProblem& problem,
+                                    int* simulations = nullptr);
 
 // Whether a step with an outcome ends valid at rest inside the goal region.
 bool solves(const Simulator& sim, SimulatorWorkspace& ws, const PathStep& step, const Goal& goal);

@@ -1,5 +1,6 @@
 #include "lazyboe/planning/problem.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -7,10 +8,38 @@
 
 namespace lazyboe {
 
+PoseTarget Goal::pose_target() const {
+  PoseTarget t;
+  t.link = link;
+  t.position = position;
+  t.position_tolerance = tolerance;
+  t.has_orientation = kind == Kind::Pose;
+  t.rotation = orientation.normalized().toRotationMatrix();
+  t.has_free_axis = has_free_axis;
+  t.free_axis = free_axis;
+  t.orientation_tolerance = orientation_tolerance;
+  return t;
+}
+
 double Goal::distance(const RobotModel& robot, RobotData& data, const JointVectorRef& state) const {
-  if (kind == Kind::Joint) return (state - q).norm();
-  forward_kinematics(robot, data, state);
-  return (link_pose(robot, data, link).p - position).norm();
+  switch (kind) {
+    case Kind::Joint:
+      return (state - q).norm();
+    case Kind::Position:
+      forward_kinematics(robot, data, state);
+      return (link_pose(robot, data, link).p - position).norm();
+    case Kind::Pose: {
+      forward_kinematics(robot, data, state);
+      const PoseError e = pose_error(pose_target(), link_pose(robot, data, link));
+      return std::max(e.position, e.orientation * tolerance / orientation_tolerance);
+    }
+    case Kind::Set:
+      break;
+  }
+  double best = std::numeric_limits<double>::infinity();
+  for (const Goal& m : members)
+    best = std::min(best, m.distance(robot, data, state) * tolerance / m.tolerance);
+  return best;
 }
 
 namespace {
@@ -69,21 +98,88 @@ bool out_of_reach(const RobotModel& robot, const Goal& g) {
 
 }  // namespace
 
+namespace {
+
+// A goal position inside an obstacle's solid: no link origin can get there.
+ProblemIssue inside_obstacle(const Simulator& sim, SimulatorWorkspace& ws, const std::string& field,
+                             const Eigen::Vector3d& position) {
+  const int o = obstacle_at(sim.collision, ws.collision, position);
+  if (o < 0) return {};
+  return {field, "inside obstacle '" + sim.collision.obstacles[o].name + "'"};
+}
+
+ProblemIssue pose_issue(const Simulator& sim, SimulatorWorkspace& ws, const std::string& field,
+                        const Goal& g) {
+  if (g.link < 0 || g.link >= static_cast<int>(sim.robot.links.size()))
+    return {field + ".pose.link", "no link " + std::to_string(g.link)};
+  if (!(g.tolerance > 0)) return {field + ".position_tolerance", "must be > 0"};
+  if (!(g.orientation_tolerance > 0)) return {field + ".orientation_tolerance", "must be > 0"};
+  if (ProblemIssue i = inside_obstacle(sim, ws, field + ".pose.position", g.position); i.any())
+    return i;
+  if (g.resolved && g.reached == 0) {
+    return {field + ".pose",
+            "no configuration within the joint limits reaches it within the tolerances (" +
+                std::to_string(g.attempts) + " attempts of inverse kinematics)"};
+  }
+  // Every configuration found that reaches it collides: the link there touches an obstacle
+  // (or the arm itself) whichever way the arm reaches it, as far as the search saw.
+  if (g.resolved && g.configurations.empty()) {
+    return {field + ".pose", "every configuration found that reaches it (" +
+                                 std::to_string(g.reached) + " in " + std::to_string(g.attempts) +
+                                 " attempts of inverse kinematics) is in collision"};
+  }
+  return {};
+}
+
+ProblemIssue goal_issue(const Simulator& sim, SimulatorWorkspace& ws, const std::string& field,
+                        const Goal& g);
+
+// A set is refused only when no member is acceptable (then for its first member's issue).
+ProblemIssue set_issue(const Simulator& sim, SimulatorWorkspace& ws, const std::string& field,
+                       const Goal& g) {
+  if (g.members.empty()) return {field, "an empty goal set"};
+  ProblemIssue first;
+  for (size_t i = 0; i < g.members.size(); ++i) {
+    const ProblemIssue issue =
+        goal_issue(sim, ws, field + "[" + std::to_string(i) + "]", g.members[i]);
+    if (!issue.any()) return {};
+    if (!first.any()) first = issue;
+  }
+  first.what += " (and no member of the goal set is acceptable)";
+  return first;
+}
+
+ProblemIssue goal_issue(const Simulator& sim, SimulatorWorkspace& ws, const std::string& field,
+                        const Goal& g) {
+  switch (g.kind) {
+    case Goal::Kind::Joint:
+      if (ProblemIssue i = state_issue(sim, ws, field + ".q", g.q); i.any()) return i;
+      break;
+    case Goal::Kind::Position:
+      if (g.link < 0 || g.link >= static_cast<int>(sim.robot.links.size()))
+        return {field + ".link", "no link " + std::to_string(g.link)};
+      if (out_of_reach(sim.robot, g))
+        return {field + ".position", "unreachable: farther than the arm can reach"};
+      if (ProblemIssue i = inside_obstacle(sim, ws, field + ".position", g.position); i.any())
+        return i;
+      break;
+    case Goal::Kind::Pose:
+      return pose_issue(sim, ws, field, g);
+    case Goal::Kind::Set:
+      return set_issue(sim, ws, field, g);
+  }
+  if (!(g.tolerance > 0)) return {field + ".tolerance", "must be > 0"};
+  return {};
+}
+
+}  // namespace
+
 ProblemIssue find_problem_issue(const Simulator& sim, SimulatorWorkspace& ws,
                                 const PlanningProblem& p) {
-  const RobotModel& robot = sim.robot;
   if (ProblemIssue i = state_issue(sim, ws, "start", p.start); i.any()) return i;
-  const Goal& g = p.goal;
-  if (g.kind == Goal::Kind::Joint) {
-    if (ProblemIssue i = state_issue(sim, ws, "goal.q", g.q); i.any()) return i;
-  } else {
-    if (g.link < 0 || g.link >= static_cast<int>(robot.links.size()))
-      return {"goal.link", "no link " + std::to_string(g.link)};
-    if (out_of_reach(robot, g))
-      return {"goal.position", "unreachable: farther than the arm can reach"};
-  }
-  if (!(g.tolerance > 0)) return {"goal.tolerance", "must be > 0"};
-  if (g.contains(robot, ws.robot, p.start)) return {"goal", "the start already satisfies the goal"};
+  if (ProblemIssue i = goal_issue(sim, ws, "goal", p.goal); i.any()) return i;
+  if (p.goal.contains(sim.robot, ws.robot, p.start))
+    return {"goal", "the start already satisfies the goal"};
   if (!(p.termination.budget > 0 && p.termination.budget <= kMaxBudgetSeconds))
     return {"budget", "must be in (0, 1000000] s"};
   return {};

@@ -13,24 +13,55 @@
 #include <utility>
 #include <vector>
 
+#include "lazyboe/robot/inverse_kinematics.h"
 #include "lazyboe/sim/simulator.h"
 
 namespace lazyboe {
 
 struct Goal {
-  enum class Kind { Joint, Position };
+  enum class Kind { Joint, Position, Pose, Set };
   Kind kind = Kind::Joint;
   JointVector q;                                       // Joint
-  Eigen::Vector3d position = Eigen::Vector3d::Zero();  // Position: of `link`, base frame
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();  // Position, Pose: of `link`, base frame
   int link = -1;
-  double tolerance = 0.1;  // rad (Euclidean in joint space) or m
+  // rad (Euclidean in joint space), m (Position; Pose: of the position), or a Set's first
+  // member's.
+  double tolerance = 0.1;
+  // Pose: the link's orientation, to within orientation_tolerance (rad), all of it or all but
+  // the rotations about free_axis (base frame: any yaw about the vertical).
+  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();
+  bool has_free_axis = false;
+  Eigen::Vector3d free_axis = Eigen::Vector3d::UnitZ();
+  double orientation_tolerance = 0.05;
+  // Set: any member will do (several grasps of one object); members are not sets.
+  std::vector<Goal> members;
+  // Pose goals and sets (resolve_goal): configurations inside the goal region, within the joint
+  // limits and free of collision, nearest the start first, which direct commands aim at; and
+  // how many attempts of inverse kinematics reached the goal at all.
+  std::vector<JointVector> configurations;
+  bool resolved = false;
+  int reached = 0, attempts = 0;
 
-  // Heuristic: joint-space distance to q, or Cartesian distance of the link to the position.
+  PoseTarget pose_target() const;  // Position, Pose
+  // Heuristic, in the unit of `tolerance`: the joint-space distance to q; the Cartesian
+  // distance of the link to the position; for a pose the larger of the position error and the
+  // orientation error weighted by tolerance / orientation_tolerance (so that the region is
+  // distance <= tolerance); for a set the least of its members', each scaled to the first
+  // member's tolerance.
   double distance(const RobotModel& robot, RobotData& data, const JointVectorRef& state) const;
   bool contains(const RobotModel& robot, RobotData& data, const JointVectorRef& state) const {
     return distance(robot, data, state) <= tolerance;
   }
 };
+
+// Whether resolve_goal finds configurations for the goal (pose goals and sets).
+bool needs_configurations(const Goal& goal);
+
+// Fills goal.configurations for a pose goal or a set (joint members: their q when valid), by
+// inverse kinematics from `start` and from seeded random configurations of the robot's region
+// and joint limits; sets goal.resolved. Deterministic in `seed`.
+void resolve_goal(const Simulator& sim, SimulatorWorkspace& ws, const JointVectorRef& start,
+                  uint64_t seed, Goal& goal);
 
 // When a solve stops: its wall-clock budget has run out or, with stop_at_first, it has found a
 // solution. (RRT, OMPL's RRT and KPIECE always stop at their first solution.)
@@ -57,7 +88,7 @@ struct PlanningProblem {
 };
 
 // What is wrong with a problem: the field at fault ("start", "goal.q", "goal.position",
-// "goal") and why. Empty field: nothing.
+// "goal.pose", "goal") and why. Empty field: nothing.
 struct ProblemIssue {
   std::string field, what;
   bool any() const { return !field.empty(); }

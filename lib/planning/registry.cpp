@@ -167,6 +167,12 @@ PlanResult plan(const PlanningContext& context, SimulatorWorkspace& ws, const st
                 const ParameterValues& values, const PlanningProblem& problem, RolloutPool* pool) {
   const std::unique_ptr<Planner> p = make_planner(planner, values);
   p->setup(context);
+  if (needs_configurations(problem.goal) && !problem.goal.resolved) {
+    PlanningProblem resolved = problem;
+    resolve_goal(context.sim, ws, resolved.start, resolved.seed, resolved.goal);
+    validate_problem(context.sim, ws, resolved);
+    return p->solve(resolved, ws, pool);
+  }
   validate_problem(context.sim, ws, problem);
   return p->solve(problem, ws, pool);
 }

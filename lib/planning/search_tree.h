@@ -58,6 +58,7 @@ class SearchState {
         goal_data_(ctx.sim.robot) {}
 
   const PlanningContext& context() const { return ctx_; }
+  SimulatorWorkspace& workspace() { return ws_; }
   const PlanningProblem& problem() const { return problem_; }
   std::vector<Node>& nodes() { return nodes_; }
   Node& node(int v) { return nodes_[v]; }
@@ -79,6 +80,11 @@ class SearchState {
     count(r);
     return r;
   }
+  // Counts `n` simulations of one corrected command, the last of them `last`.
+  void count_simulations(int n, const RolloutResult& last) {
+    result_.counters.simulations += n - 1;
+    count(last);
+  }
   // Counts a rollout the search uses (run here, or ahead of time by a RolloutPool).
   void count(const RolloutResult& r) {
     ++result_.counters.simulations;
@@ -98,9 +104,10 @@ class SearchState {
   // is the solve's answer, found_by "direct" (no path is shorter by more than the goal's
   // tolerance, so the search is not run); true then.
   bool connect_directly() {
-    std::optional<PathStep> step = direct_step(ctx_.sim, ws_, ctx_.command, problem_);
+    int simulations = 0;
+    std::optional<PathStep> step = direct_step(ctx_.sim, ws_, ctx_.command, problem_, &simulations);
     if (!step) return false;
-    count(*step->outcome);
+    count_simulations(simulations, *step->outcome);
     if (!solves(ctx_.sim, ws_, *step, problem_.goal)) return false;
     offer(step->outcome->path_length, [&] { return std::vector<PathStep>{std::move(*step)}; });
     result_.found_by = "direct";

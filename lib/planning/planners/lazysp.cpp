@@ -33,6 +33,9 @@ constexpr double kFailuresPerShare = 20;
 // Expansions of a round's first search in a scene other than the bundle's, with the scene's
 // marks in the edge cost, before the round searches without them.
 constexpr size_t kMarkedSearchLimit = 1000;
+// How near (joint space, rad) a real node must be to a pose goal's configuration to try the
+// direct command to it.
+constexpr double kConnectRadius = 1.0;
 
 // The declared parameters' values (lazysp_planner_info has their defaults).
 struct Settings {
@@ -90,6 +93,7 @@ class LazySpSearch {
   void enqueue(Predicted x, double h);
   bool validate(const std::vector<Predicted>& chain);
   void grow();
+  bool connect_to_goal(int v);
   // A real node: the end of rollout r from `parent` (-1 and r.qf the start: the root).
   int add_real(const RolloutResult& r, int parent, int64_t edge, int command);
   void found(int node, const char* by);
@@ -321,6 +325,7 @@ bool LazySpSearch::validate(const std::vector<Predicted>& chain) {
       found(c, "bundle");
       return true;
     }
+    if (connect_to_goal(c)) return true;
     if ((res.qf - chain[k].q).norm() > set_.theta / 2) return false;
     r = c;
   }
@@ -342,7 +347,37 @@ void LazySpSearch::grow() {
   if (!res.valid()) return;
   commands_.push_back({-1, std::move(knots), duration});
   const int c = add_real(res, from, -1, static_cast<int>(commands_.size()) - 1);
-  if (s_.in_goal(s_.node(c).h)) found(c, "growth");
+  if (s_.in_goal(s_.node(c).h)) {
+    found(c, "growth");
+  } else {
+    connect_to_goal(c);
+  }
+}
+
+// Pose goals and goal sets, whose small regions a bundle edge or a growth command seldom ends
+// in: from a new real node within kConnectRadius of one of the goal's configurations, the
+// direct command to it, corrected to land in the goal (direct_step_to). True when it did.
+bool LazySpSearch::connect_to_goal(int v) {
+  const std::vector<JointVector>& targets = s_.problem().goal.configurations;
+  if (targets.empty()) return false;
+  const JointVector& q = s_.node(v).q;
+  const JointVector* nearest = &targets.front();
+  for (const JointVector& t : targets)
+    if ((t - q).norm() < (*nearest - q).norm()) nearest = &t;
+  if ((*nearest - q).norm() > kConnectRadius) return false;
+  int simulations = 0;
+  std::optional<PathStep> step = direct_step_to(ctx_.sim, s_.workspace(), ctx_.command, q, *nearest,
+                                                &s_.problem().goal, &simulations);
+  if (!step) return false;
+  s_.count_simulations(simulations, *step->outcome);
+  growth_work_ += simulations;
+  if (!step->outcome->valid()) return false;
+  const RolloutResult outcome = *step->outcome;
+  commands_.push_back({-1, std::move(step->knots), step->command_duration});
+  const int c = add_real(outcome, v, -1, static_cast<int>(commands_.size()) - 1);
+  if (!s_.in_goal(s_.node(c).h)) return false;
+  found(c, "connection");
+  return true;
 }
 
 int LazySpSearch::add_real(const RolloutResult& r, int parent, int64_t edge, int command) {

@@ -67,6 +67,12 @@ void sample_state(const PlanningContext& ctx, const PlanningProblem& p, double g
     x = p.goal.q;
     return;
   }
+  // Pose goals and sets: one of their configurations.
+  const std::vector<JointVector>& in_goal = p.goal.configurations;
+  if (!in_goal.empty() && rng.uniform() < goal_bias) {
+    x = in_goal[static_cast<size_t>(rng.uniform() * in_goal.size()) % in_goal.size()];
+    return;
+  }
   for (int i = 0; i < x.size(); ++i) x[i] = rng.uniform(ctx.sample_lower[i], ctx.sample_upper[i]);
 }
 
