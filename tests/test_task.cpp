@@ -25,6 +25,7 @@
 #include "lazyboe/planning/request.h"
 #include "lazyboe/planning/world.h"
 #include "lazyboe/robot/dynamics.h"
+#include "lazyboe/robot/inverse_kinematics.h"
 #include "lazyboe/robot/payload.h"
 #include "lazyboe/sim/random.h"
 #include "lazyboe/sim/trajectory_check.h"
@@ -316,6 +317,146 @@ TEST(EndEffectorLimits, ALimitNoMotionMeetsIsAClearFailure) {
 }
 
 // ------------------------------------------------------------------------------------------
+// Pose goals and goal sets
+// ------------------------------------------------------------------------------------------
+
+// The tip's pose at q, by forward kinematics.
+Pose tip_pose(const RobotModel& robot, const JointVectorRef& q) {
+  RobotData d(robot);
+  forward_kinematics(robot, d, q);
+  return link_pose(robot, d, robot.tip_link());
+}
+
+// The pose of the tip at q as a goal: 1 cm and 0.05 rad.
+Goal pose_goal(const RobotModel& robot, const JointVectorRef& q) {
+  const Pose p = tip_pose(robot, q);
+  Goal g;
+  g.kind = Goal::Kind::Pose;
+  g.link = robot.tip_link();
+  g.position = p.p;
+  g.orientation = Eigen::Quaterniond(p.R);
+  g.tolerance = 0.01;
+  g.orientation_tolerance = 0.05;
+  return g;
+}
+
+// Position error (m) and orientation error (rad) of the tip at q against g, computed here: the
+// angle of the relative rotation, or for a free axis the angle between where the link carries
+// the goal's held axis and that axis.
+std::pair<double, double> tip_errors(const RobotModel& robot, const JointVectorRef& q,
+                                     const Goal& g) {
+  const Pose p = tip_pose(robot, q);
+  const Eigen::Matrix3d Rg = g.orientation.toRotationMatrix();
+  double angle = Eigen::AngleAxisd(Rg.transpose() * p.R).angle();
+  if (g.has_free_axis) {
+    const Eigen::Vector3d held = p.R * (Rg.transpose() * g.free_axis);
+    angle = std::acos(std::clamp(held.dot(g.free_axis), -1.0, 1.0));
+  }
+  return {(p.p - g.position).norm(), angle};
+}
+
+PlanRequest goal_request(const std::string& planner, const JointVectorRef& start, Goal goal,
+                         bool search) {
+  PlanRequest r;
+  r.planner = planner;
+  if (search) r.parameters = searching(planner);
+  r.problem.start = start;
+  r.problem.goal = std::move(goal);
+  r.problem.termination.budget = 10 * time_scale();
+  r.problem.termination.stop_at_first = true;
+  return r;
+}
+
+TEST(PoseGoal, TheReturnedTrajectoryEndsAtRestWithinBothTolerances) {
+  const Fixture& f = fixture();
+  const PlanningContext context = bundle_context(f.sim, f.view, f.index);
+  SimulatorWorkspace ws(f.sim);
+  const Goal goal = pose_goal(f.robot, f.c);
+  for (const auto& [planner, search] : std::vector<std::pair<std::string, bool>>{
+           {"lazysp", false}, {"lazysp", true}, {"boe", false}, {"rrt", false}}) {
+    const PlanAnswer a = answer_request(context, goal_request(planner, f.a, goal, search), ws);
+    ASSERT_TRUE(a.result.success) << planner << ": " << a.result.failure;
+    const auto [position, orientation] = tip_errors(f.robot, a.trajectory.q.back(), goal);
+    EXPECT_LE(position, 0.01) << planner << " search " << search;
+    EXPECT_LE(orientation, 0.05) << planner << " search " << search;
+    EXPECT_LE(a.trajectory.dq.back().cwiseAbs().maxCoeff(), f.sim.options.settle_velocity);
+    if (planner == "lazysp") EXPECT_EQ(a.result.found_by, search ? "connection" : "direct");
+  }
+}
+
+TEST(PoseGoal, AFreeAxisAcceptsAnyRotationAboutItAndNoOther) {
+  const Fixture& f = fixture();
+  RobotData d(f.robot);
+  Goal goal = pose_goal(f.robot, f.c);
+  goal.has_free_axis = true;
+  const Eigen::Quaterniond held = goal.orientation;
+  for (double yaw : {-3.0, -1.0, 0.5, 2.0, 3.1}) {
+    goal.orientation = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) * held;
+    EXPECT_TRUE(goal.contains(f.robot, d, f.c)) << "yaw " << yaw;
+  }
+  for (const Eigen::Vector3d& axis : {Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY()}) {
+    goal.orientation = Eigen::AngleAxisd(0.1, axis) * held;
+    EXPECT_FALSE(goal.contains(f.robot, d, f.c)) << axis.transpose();
+    EXPECT_NEAR(tip_errors(f.robot, f.c, goal).second, 0.1, 1e-9);
+  }
+  // Planned: a goal turned by 1 rad of yaw is reached with the yaw left free.
+  goal.orientation = Eigen::AngleAxisd(1.0, Eigen::Vector3d::UnitZ()) * held;
+  SimulatorWorkspace ws(f.sim);
+  const PlanAnswer a = answer_request(bundle_context(f.sim, f.view, f.index),
+                                      goal_request("lazysp", f.a, goal, false), ws);
+  ASSERT_TRUE(a.result.success) << a.result.failure;
+  const auto [position, orientation] = tip_errors(f.robot, a.trajectory.q.back(), goal);
+  EXPECT_LE(position, 0.01);
+  EXPECT_LE(orientation, 0.05);
+}
+
+TEST(PoseGoal, AGoalSetReturnsAPathToOneOfItsMembers) {
+  const Fixture& f = fixture();
+  Goal set;
+  set.kind = Goal::Kind::Set;
+  Goal far = pose_goal(f.robot, f.c);
+  far.position += Eigen::Vector3d(0, 0, 5);  // out of reach: never reached
+  Goal joint;
+  joint.q = f.b;
+  joint.tolerance = kTolerance;
+  set.members = {far, pose_goal(f.robot, f.c), joint};
+  set.tolerance = set.members[0].tolerance;
+  SimulatorWorkspace ws(f.sim);
+  const PlanningContext context = bundle_context(f.sim, f.view, f.index);
+  for (bool search : {false, true}) {
+    const PlanAnswer a = answer_request(context, goal_request("lazysp", f.a, set, search), ws);
+    ASSERT_TRUE(a.result.success) << a.result.failure;
+    const JointVector& end = a.trajectory.q.back();
+    const auto [position, orientation] = tip_errors(f.robot, end, set.members[1]);
+    const bool at_pose = position <= 0.01 && orientation <= 0.05;
+    const bool at_joint = (end - f.b).norm() <= kTolerance;
+    EXPECT_TRUE(at_pose || at_joint) << "search " << search;
+  }
+}
+
+TEST(PoseGoal, InverseKinematicsReachesPosesOfTheRegion) {
+  const Fixture& f = fixture();
+  RobotData d(f.robot);
+  Random rng(3, 0);
+  int solved = 0;
+  for (int trial = 0; trial < 20; ++trial) {
+    JointVector target(7), q(7);
+    for (int i = 0; i < 7; ++i) {
+      target[i] = rng.uniform(f.robot.region_lower[i], f.robot.region_upper[i]);
+      q[i] = rng.uniform(f.robot.region_lower[i], f.robot.region_upper[i]);
+    }
+    const Goal g = pose_goal(f.robot, target);
+    if (!solve_ik(f.robot, d, g.pose_target(), q)) continue;
+    ++solved;
+    const auto [position, orientation] = tip_errors(f.robot, q, g);
+    EXPECT_LE(position, 0.2 * 0.01);
+    EXPECT_LE(orientation, 0.2 * 0.05);
+    EXPECT_TRUE(((q.array() > f.robot.q_min.array()) && (q.array() < f.robot.q_max.array())).all());
+  }
+  EXPECT_GE(solved, 15);  // from one random seed each
+}
+
+// ------------------------------------------------------------------------------------------
 // Bad input: one line naming the field
 // ------------------------------------------------------------------------------------------
 
@@ -350,6 +491,25 @@ TEST(TaskInput, BadFieldsAreOneLineNamingTheField) {
        "line 1: end_effector_limits.axis: must not be zero"},
       {{{"end_effector_limits", {{"max_linear_speed", 0}}}},
        "line 1: end_effector_limits.max_linear_speed: 0 is outside"},
+      {json::parse(
+           R"({"goal": {"pose": {"position": [0.5, 0, 0.5], "orientation": [0, 0, 0, 0]}}})"),
+       "line 1: goal.pose.orientation: a quaternion of norm 0"},
+      {json::parse(
+           R"({"goal": {"pose": {"position": [0.65, 0.1, 0.18], "orientation": [1, 0, 0, 0]}}})"),
+       "line 1: goal.pose.position: inside obstacle 'table_top'"},
+      {json::parse(R"({"goal": {"position": [0.65, 0.1, 0.18]}})"),
+       "line 1: goal.position: inside obstacle 'table_top'"},
+      {json::parse(
+           R"({"goal": {"pose": {"position": [2.5, 0, 0.5], "orientation": [1, 0, 0, 0]}}})"),
+       "line 1: goal.pose: no configuration within the joint limits reaches it"},
+      {json::parse(R"({"goal": {"pose": {"position": [0.5, 0, 0.5], "orientation": [1, 0, 0, 0]},
+                                "orientation_tolerance": -1}})"),
+       "line 1: goal.orientation_tolerance: -1 is outside"},
+      {json::parse(R"({"goal": [{"q": [9, 9, 9, 9, 9, 9, 9]},
+                                {"pose": {"position": [0.65, 0.1, 0.18],
+                                          "orientation": [1, 0, 0, 0]}}]})"),
+       "line 1: goal[0].q: outside the joint limits"},
+      {json::parse(R"({"goal": []})"), "line 1: goal: an empty goal set"},
   };
   for (const auto& [extra, expected] : cases) {
     const std::string error = query_error(extra);

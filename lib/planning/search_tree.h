@@ -47,6 +47,10 @@ struct SearchNode {
   }
 };
 
+// How near (joint space, rad) a real node must be to a configuration of a pose goal for
+// goal_connection to try the direct command to it.
+constexpr double kGoalConnectRadius = 1.0;
+
 template <typename Node>
 class SearchState {
  public:
@@ -112,6 +116,26 @@ class SearchState {
     offer(step->outcome->path_length, [&] { return std::vector<PathStep>{std::move(*step)}; });
     result_.found_by = "direct";
     return true;
+  }
+
+  // Pose goals and goal sets, whose small regions a bundle edge or a random command seldom ends
+  // in: from q within kGoalConnectRadius of one of the goal's configurations, the direct
+  // command to the nearest, corrected to land in the goal (direct_step_to). The step when it
+  // simulates valid; `simulations` gets how many it ran (all counted here).
+  std::optional<PathStep> goal_connection(const JointVector& q, int& simulations) {
+    simulations = 0;
+    const std::vector<JointVector>& targets = problem_.goal.configurations;
+    if (targets.empty()) return std::nullopt;
+    const JointVector* nearest = &targets.front();
+    for (const JointVector& t : targets)
+      if ((t - q).norm() < (*nearest - q).norm()) nearest = &t;
+    if ((*nearest - q).norm() > kGoalConnectRadius) return std::nullopt;
+    std::optional<PathStep> step =
+        direct_step_to(ctx_.sim, ws_, ctx_.command, q, *nearest, &problem_.goal, &simulations);
+    if (!step) return std::nullopt;
+    count_simulations(simulations, *step->outcome);
+    if (!step->outcome->valid()) return std::nullopt;
+    return step;
   }
 
   // The budget has run out, or the caller cancelled the solve.

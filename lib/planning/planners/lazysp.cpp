@@ -33,9 +33,6 @@ constexpr double kFailuresPerShare = 20;
 // Expansions of a round's first search in a scene other than the bundle's, with the scene's
 // marks in the edge cost, before the round searches without them.
 constexpr size_t kMarkedSearchLimit = 1000;
-// How near (joint space, rad) a real node must be to a pose goal's configuration to try the
-// direct command to it.
-constexpr double kConnectRadius = 1.0;
 
 // The declared parameters' values (lazysp_planner_info has their defaults).
 struct Settings {
@@ -354,24 +351,13 @@ void LazySpSearch::grow() {
   }
 }
 
-// Pose goals and goal sets, whose small regions a bundle edge or a growth command seldom ends
-// in: from a new real node within kConnectRadius of one of the goal's configurations, the
-// direct command to it, corrected to land in the goal (direct_step_to). True when it did.
+// Pose goals and goal sets: the direct command from a new real node to the goal
+// (SearchState::goal_connection), counted as growth work. True when it reached the goal.
 bool LazySpSearch::connect_to_goal(int v) {
-  const std::vector<JointVector>& targets = s_.problem().goal.configurations;
-  if (targets.empty()) return false;
-  const JointVector& q = s_.node(v).q;
-  const JointVector* nearest = &targets.front();
-  for (const JointVector& t : targets)
-    if ((t - q).norm() < (*nearest - q).norm()) nearest = &t;
-  if ((*nearest - q).norm() > kConnectRadius) return false;
   int simulations = 0;
-  std::optional<PathStep> step = direct_step_to(ctx_.sim, s_.workspace(), ctx_.command, q, *nearest,
-                                                &s_.problem().goal, &simulations);
-  if (!step) return false;
-  s_.count_simulations(simulations, *step->outcome);
+  std::optional<PathStep> step = s_.goal_connection(s_.node(v).q, simulations);
   growth_work_ += simulations;
-  if (!step->outcome->valid()) return false;
+  if (!step) return false;
   const RolloutResult outcome = *step->outcome;
   commands_.push_back({-1, std::move(step->knots), step->command_duration});
   const int c = add_real(outcome, v, -1, static_cast<int>(commands_.size()) - 1);

@@ -51,8 +51,9 @@ PlanResult TreeSearch::run() {
     commands_.push_back({-1, knots, duration});
     const int id = add(c, from);
     added(id);
-    if (s_.in_goal(c.h)) {
-      s_.solution(id, [this](int u) { return path_to(u); });
+    if (s_.in_goal(c.h) || connect(id)) {
+      s_.solution(s_.in_goal(c.h) ? id : static_cast<int>(s_.nodes().size()) - 1,
+                  [this](int u) { return path_to(u); });
       if (stop_at_solution()) break;
     }
   }
@@ -74,6 +75,23 @@ void sample_state(const PlanningContext& ctx, const PlanningProblem& p, double g
     return;
   }
   for (int i = 0; i < x.size(); ++i) x[i] = rng.uniform(ctx.sample_lower[i], ctx.sample_upper[i]);
+}
+
+// Pose goals and goal sets: the direct command from node v into the goal
+// (SearchState::goal_connection); true when it reached it (the goal node added last).
+bool TreeSearch::connect(int v) {
+  int simulations = 0;
+  std::optional<PathStep> step = s_.goal_connection(s_.node(v).q, simulations);
+  if (!step) return false;
+  TreeNode g;
+  g.reached(*step->outcome, s_.node(v).cost);
+  g.parent = v;
+  g.h = s_.heuristic(g.q);
+  if (!s_.in_goal(g.h)) return false;
+  g.command = static_cast<int>(commands_.size());
+  commands_.push_back({-1, std::move(step->knots), step->command_duration});
+  added(add(g, v));
+  return true;
 }
 
 void TreeSearch::sample(JointVector& x) { sample_state(ctx_, s_.problem(), goal_bias_, rng_, x); }

@@ -73,6 +73,7 @@ class TreeSearch {
 
  private:
   void sample(JointVector& x);
+  bool connect(int v);
   int add(TreeNode c, int from);
   std::vector<PathStep> path_to(int node);
 
