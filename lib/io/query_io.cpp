@@ -222,7 +222,8 @@ WorldPtr parse_task(const JsonField& root, const Simulator& sim, SimulatorWorksp
 }  // namespace
 
 Query read_query(const nlohmann::json& doc, const std::string& where, const Simulator& sim,
-                 SimulatorWorkspace& ws, const QueryDefaults& d, SceneCache* scenes) {
+                 SimulatorWorkspace& ws, const QueryDefaults& d, SceneCache* scenes,
+                 const WorldPtr& base) {
   if (!doc.is_object()) fail(where, "expected a JSON object");
   const JsonField root(doc, where, "");
   root.allow_only(query_fields());
@@ -232,7 +233,7 @@ Query read_query(const nlohmann::json& doc, const std::string& where, const Simu
   q.request.output = parse_output(root, d.output);
   q.world = parse_scene(root, scenes);
   parse_problem(root, q.world ? q.world->sim : sim, d, q.request.problem);
-  q.world = parse_task(root, sim, ws, q.world, scenes, q.request.problem.start);
+  q.world = parse_task(root, sim, ws, q.world ? q.world : base, scenes, q.request.problem.start);
   const Simulator& in = q.world ? q.world->sim : sim;
   PlanningProblem& p = q.request.problem;
   if (needs_configurations(p.goal)) resolve_goal(in, ws, p.start, p.seed, p.goal);

@@ -18,7 +18,8 @@ struct Query {
   std::string id;
   int line = 0;
   PlanRequest request;
-  // The scene it names ("scene": a file or an inline environment); null: the caller's default.
+  // The scene it names ("scene": a file or an inline environment) with the query's task
+  // (payload, end-effector limits); null: the caller's default.
   WorldPtr world;
 };
 
@@ -41,10 +42,11 @@ struct QueryDefaults {
 Query parse_query(const std::string& text, int line, const Simulator& sim, SimulatorWorkspace& ws,
                   const QueryDefaults& defaults, std::string& id_out, SceneCache* scenes = nullptr);
 // The same for a query held as JSON; `where` starts its errors ("line 3", "queries[2]"; empty:
-// the field alone).
+// the field alone). `base`: the caller's world when it is not the session's default (`sim` is
+// its simulator): a query's task (payload, end-effector limits) is added to it.
 Query read_query(const nlohmann::json& doc, const std::string& where, const Simulator& sim,
                  SimulatorWorkspace& ws, const QueryDefaults& defaults,
-                 SceneCache* scenes = nullptr);
+                 SceneCache* scenes = nullptr, const WorldPtr& base = nullptr);
 
 enum class TrajectoryOutput { None, Inline, Csv };
 

@@ -136,8 +136,8 @@ struct PlanResult {
   PlannerCounters counters;
   std::string failure;  // why there is no solution
   // Which part of the planner found the best path, for planners with several: "direct" (the
-  // bundle planners' straight command, tried first), "bundle" or "growth" (lazysp's search or
-  // growth); empty for the others.
+  // bundle planners' straight command, tried first), "bundle", "growth" or "connection"
+  // (lazysp's search, growth, or direct command into a pose goal); empty for the others.
   std::string found_by;
 };
 

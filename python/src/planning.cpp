@@ -81,7 +81,7 @@ Query read(const Session& s, SimulatorWorkspace& ws, const nlohmann::json& doc,
            const WorldPtr& world = nullptr) {
   try {
     return read_query(doc, where, world ? world->sim : s.session->sim(), ws, defaults,
-                      &s.session->scenes);
+                      &s.session->scenes, world);
   } catch (const Error& e) {
     throw InputError(e.what());
   }
@@ -148,7 +148,7 @@ PyResult plan_one(const Session& s, const py::object& start, const py::object& g
   std::atomic<bool> cancel{false};
   SimulatorWorkspace ws(s.session->sim());
   Query q = read(s, ws, doc, "", defaults, loaded);
-  if (loaded) q.world = loaded;
+  if (loaded && !q.world) q.world = loaded;
   q.request.problem.termination.cancel = &cancel;
   return interruptible(cancel, [&] {
     RolloutPool pool(s.session->sim(), sim_threads);
@@ -530,10 +530,14 @@ void bind_planning(py::module_& m) {
            py::arg("scene") = py::none(), py::arg("sample_interval") = 0.01,
            py::arg("sim_threads") = 1, py::arg("raw") = false,
            "Plans one query, as a line of lazyboe-query would: start (dof values), goal "
-           "({'q': [...], 'tolerance': 0.1} or {'position': [x, y, z], 'tolerance': 0.02, "
-           "'link': name}), planner (lazyboe.planners()), budget (s, default 5), seed (default "
-           "1), and the planner's parameters by name as keywords (stop_at_first=True, "
-           "theta=0.4, ...). scene: the environment to plan in: a Scene (load_scene), an "
+           "({'q': [...], 'tolerance': 0.1}, {'position': [x, y, z], 'tolerance': 0.02, "
+           "'link': name}, {'pose': {'position': [x, y, z], 'orientation': [w, x, y, z]}, "
+           "'position_tolerance': 0.01, 'orientation_tolerance': 0.05}, or a list of goals, any "
+           "of which will do), planner (lazyboe.planners()), budget (s, default 5), seed (default "
+           "1), and the planner's parameters and the task by name as keywords (stop_at_first=True, "
+           "theta=0.4, payload={'mass': 3.0, 'com': [0, 0, 0.05]}, end_effector_limits="
+           "{'max_linear_acceleration': 3.0}, ...). scene: the environment to plan in: a Scene "
+           "(load_scene), an "
            "environment file's path or an environment dict (default: the session's); scenes "
            "are kept by content, so naming one again reuses its collision model. "
            "sample_interval: trajectory sample spacing, s (0.001: every control "

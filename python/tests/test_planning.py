@@ -126,6 +126,49 @@ def test_position_goal(session, tool_results):
     assert np.linalg.norm(reached - target) <= 0.03
 
 
+def rotation_angle(a, b):
+    """Angle of the rotation between two rotation matrices, rad."""
+    return float(np.arccos(np.clip((np.trace(a.T @ b) - 1) / 2, -1, 1)))
+
+
+def test_pose_goal_and_the_task_at_query_time(session, tmp_path):
+    """A pose goal, a payload and end-effector limits through plan(), as a query line has them;
+    the end pose checked here, the trajectory by validate-trajectory with the same task."""
+    robot = session.robot
+    pose = robot.forward_kinematics(GOAL)
+    w, x, y, z = [float(v) for v in quaternion(pose[:3, :3])]
+    goal = {"pose": {"position": pose[:3, 3].tolist(), "orientation": [w, x, y, z]},
+            "position_tolerance": 0.01, "orientation_tolerance": 0.05}
+    payload = {"mass": 1.0, "com": [0, 0, 0.1]}
+    limits = {"max_linear_acceleration": 3.0, "max_linear_speed": 1.0}
+    r = session.plan(START, goal, planner="lazysp", seed=1, stop_at_first=True, budget=20,
+                     payload=payload, end_effector_limits=limits, sample_interval=0.001)
+    assert r.success, r.failure
+    end = robot.forward_kinematics(r.trajectory.q[-1])
+    assert np.linalg.norm(end[:3, 3] - pose[:3, 3]) <= 0.01
+    assert rotation_angle(end[:3, :3], pose[:3, :3]) <= 0.05
+    csv = tmp_path / "t.csv"
+    t = r.trajectory
+    header = ["t"] + [f"q{i + 1}" for i in range(7)] + [f"dq{i + 1}" for i in range(7)]
+    rows = [[t.t[k], *t.q[k], *t.dq[k]] for k in range(len(t.t))]
+    csv.write_text(",".join(header) + "\n" + "".join(",".join(repr(float(v)) for v in row) + "\n"
+                                                      for row in rows))
+    check = tool("lazyboe-robot", "validate-trajectory", "--in", csv, "--payload",
+                 json.dumps(payload), "--end-effector-limits", json.dumps(limits))
+    assert check.stdout.startswith("valid"), check.stdout
+    with pytest.raises(ValueError, match="payload.mass"):
+        session.plan(START, goal, payload={"mass": -1})
+
+
+def quaternion(m):
+    """[w, x, y, z] of a rotation matrix (w >= 0)."""
+    w = np.sqrt(max(0.0, 1 + m[0, 0] + m[1, 1] + m[2, 2])) / 2
+    x = np.copysign(np.sqrt(max(0.0, 1 + m[0, 0] - m[1, 1] - m[2, 2])) / 2, m[2, 1] - m[1, 2])
+    y = np.copysign(np.sqrt(max(0.0, 1 - m[0, 0] + m[1, 1] - m[2, 2])) / 2, m[0, 2] - m[2, 0])
+    z = np.copysign(np.sqrt(max(0.0, 1 - m[0, 0] - m[1, 1] + m[2, 2])) / 2, m[1, 0] - m[0, 1])
+    return [w, x, y, z]
+
+
 def test_no_solution_is_a_result(session):
     r = session.plan(START, {"q": GOAL, "tolerance": 0.1}, planner="rrt", budget=0.001, seed=1)
     assert not r.success
