@@ -534,12 +534,12 @@ std::optional<PathStep> direct_step_to(const Simulator& sim, SimulatorWorkspace&
 
 std::optional<PathStep> direct_step(const Simulator& sim, SimulatorWorkspace& ws,
                                     const CommandSampling& limits, const PlanningProblem& problem,
-                                    int* simulations) {
+                                    int* simulations, int target) {
   const Goal& goal = problem.goal;
   if (goal.kind == Goal::Kind::Joint)
     return direct_step_to(sim, ws, limits, problem.start, goal.q, nullptr, simulations);
-  if (goal.configurations.empty()) return std::nullopt;
-  return direct_step_to(sim, ws, limits, problem.start, goal.configurations.front(), &goal,
+  if (target >= static_cast<int>(goal.configurations.size())) return std::nullopt;
+  return direct_step_to(sim, ws, limits, problem.start, goal.configurations[target], &goal,
                         simulations);
 }
 

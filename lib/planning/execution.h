@@ -129,9 +129,10 @@ std::optional<PathStep> direct_step_to(const Simulator& sim, SimulatorWorkspace&
                                        const CommandSampling& limits, const JointVectorRef& from,
                                        const JointVector& target, const Goal* land_in,
                                        int* simulations = nullptr);
+// `target`: which of a pose goal's configurations (0: the nearest the start).
 std::optional<PathStep> direct_step(const Simulator& sim, SimulatorWorkspace& ws,
                                     const CommandSampling& limits, const PlanningProblem& problem,
-                                    int* simulations = nullptr);
+                                    int* simulations = nullptr, int target = 0);
 
 // Whether a step with an outcome ends valid at rest inside the goal region.
 bool solves(const Simulator& sim, SimulatorWorkspace& ws, const PathStep& step, const Goal& goal);

@@ -5,6 +5,7 @@
 // Internal to the planners (not installed).
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <functional>
@@ -47,6 +48,9 @@ struct SearchNode {
   }
 };
 
+// Configurations of a pose goal or goal set the direct connection tries, nearest the start
+// first (one after another while each fails).
+constexpr int kDirectTargets = 3;
 // How near (joint space, rad) a real node must be to a configuration of a pose goal for
 // goal_connection to try the direct command to it.
 constexpr double kGoalConnectRadius = 1.0;
@@ -104,18 +108,27 @@ class SearchState {
   }
 
   // Direct connection first (issue 27): the straight command from the start to a joint goal
-  // within the context's command limits (direct_step). When it ends valid in the goal region it
+  // within the context's command limits (direct_step; for a pose goal or goal set, to each of
+  // its first kDirectTargets configurations in turn). When it ends valid in the goal region it
   // is the solve's answer, found_by "direct" (no path is shorter by more than the goal's
   // tolerance, so the search is not run); true then.
   bool connect_directly() {
-    int simulations = 0;
-    std::optional<PathStep> step = direct_step(ctx_.sim, ws_, ctx_.command, problem_, &simulations);
-    if (!step) return false;
-    count_simulations(simulations, *step->outcome);
-    if (!solves(ctx_.sim, ws_, *step, problem_.goal)) return false;
-    offer(step->outcome->path_length, [&] { return std::vector<PathStep>{std::move(*step)}; });
-    result_.found_by = "direct";
-    return true;
+    const int targets =
+        problem_.goal.kind == Goal::Kind::Joint
+            ? 1
+            : std::min<int>(kDirectTargets, static_cast<int>(problem_.goal.configurations.size()));
+    for (int k = 0; k < std::max(1, targets); ++k) {
+      int simulations = 0;
+      std::optional<PathStep> step =
+          direct_step(ctx_.sim, ws_, ctx_.command, problem_, &simulations, k);
+      if (!step) return false;
+      count_simulations(simulations, *step->outcome);
+      if (!solves(ctx_.sim, ws_, *step, problem_.goal)) continue;
+      offer(step->outcome->path_length, [&] { return std::vector<PathStep>{std::move(*step)}; });
+      result_.found_by = "direct";
+      return true;
+    }
+    return false;
   }
 
   // Pose goals and goal sets, whose small regions a bundle edge or a random command seldom ends
