@@ -73,10 +73,7 @@ void parse_position_goal(const JsonField& goal, const RobotModel& robot, const Q
   g.position = goal.at("position").vec3_in({-100, 100}, " m");
   g.tolerance = goal.has("tolerance") ? goal.at("tolerance").number_in({0, 100, true}, " m")
                                       : d.position_tolerance;
-  const std::string link =
-      goal.has("link") ? goal.at("link").string() : robot.links[robot.tip_link()].name;
-  g.link = robot.link_index(link);
-  if (g.link < 0) goal.at("link").fail(robot.unknown_link(link));
+  g.link = link_field(goal, robot);
 }
 
 Eigen::Vector3d unit_vector(const JsonField& f) {
@@ -104,10 +101,7 @@ void parse_pose_goal(const JsonField& goal, const RobotModel& robot, const Query
     g.has_free_axis = true;
     g.free_axis = unit_vector(pose.at("free_axis"));
   }
-  const std::string link =
-      pose.has("link") ? pose.at("link").string() : robot.links[robot.tip_link()].name;
-  g.link = robot.link_index(link);
-  if (g.link < 0) pose.at("link").fail(robot.unknown_link(link));
+  g.link = link_field(pose, robot);
   g.tolerance = goal.has("position_tolerance")
                     ? goal.at("position_tolerance").number_in({0, 100, true}, " m")
                     : d.pose_position_tolerance;

@@ -41,11 +41,9 @@ Payload payload_from_json(const JsonField& f, const RobotModel& robot) {
   if (!f.value().is_object()) f.fail("expected an object with \"mass\" (kg)");
   f.allow_only({"mass", "com", "inertia", "box", "link"});
   Payload p;
-  const std::string link =
-      f.has("link") ? f.at("link").string() : robot.links[robot.tip_link()].name;
-  p.link = robot.link_index(link);
-  if (p.link < 0) f.at("link").fail(robot.unknown_link(link));
-  if (robot.links[p.link].body < 0) f.at("link").fail("'" + link + "' does not move");
+  p.link = link_field(f, robot);
+  if (robot.links[p.link].body < 0)
+    f.at("link").fail("'" + robot.links[p.link].name + "' does not move");
   p.mass = f.at("mass").number_in({0, 1e4}, " kg");
   if (f.has("com")) p.com = f.at("com").vec3_in({-10, 10}, " m");
   if (f.has("inertia") && f.has("box")) f.fail("give \"inertia\" or \"box\", not both");

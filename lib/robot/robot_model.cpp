@@ -203,6 +203,14 @@ const char* mesh_representation_name(MeshRepresentation representation) {
   return representation == MeshRepresentation::Exact ? "exact" : "fitted";
 }
 
+int link_field(const JsonField& object, const RobotModel& robot) {
+  if (!object.has("link")) return robot.tip_link();
+  const std::string name = object.at("link").string();
+  const int link = robot.link_index(name);
+  if (link < 0) object.at("link").fail(robot.unknown_link(name));
+  return link;
+}
+
 std::string RobotModel::unknown_link(const std::string& link_name) const {
   std::vector<std::string> names;
   for (const Link& l : links) names.push_back(l.name);

@@ -142,6 +142,11 @@ struct RobotModel {
   bool is_allowed_pair(int link_a, int link_b) const;
 };
 
+class JsonField;
+// The link an object's "link" member names (default: the tip link); throws Error naming the
+// field for an unknown one (unknown_link's text).
+int link_field(const JsonField& object, const RobotModel& robot);
+
 // Loads a robot config (JSON) and the URDF it points at. Throws Error naming the file and
 // field for anything missing, malformed or not physical.
 RobotModel load_robot(const std::string& config_path);

@@ -20,10 +20,7 @@ EndEffectorLimits end_effector_limits_from_json(const JsonField& f, const RobotM
   if (!f.value().is_object()) f.fail("expected an object");
   f.allow_only({"max_linear_speed", "max_linear_acceleration", "max_tilt", "axis", "link"});
   EndEffectorLimits e;
-  const std::string link =
-      f.has("link") ? f.at("link").string() : robot.links[robot.tip_link()].name;
-  e.link = robot.link_index(link);
-  if (e.link < 0) f.at("link").fail(robot.unknown_link(link));
+  e.link = link_field(f, robot);
   if (f.has("max_linear_speed"))
     e.max_linear_speed = f.at("max_linear_speed").number_in({0, 1e3, true}, " m/s");
   if (f.has("max_linear_acceleration"))

@@ -383,9 +383,7 @@ RolloutResult simulate(const Simulator& sim, SimulatorWorkspace& ws, const Joint
     result.path_length += (q - q_prev).norm();
     const RolloutStatus c = check_motion(sim, ws, q_prev, q, moved, k.k1q, result.collision_checks);
     if (c != RolloutStatus::Valid) return finish(c, tick);
-    if (sample_every > 0 && (tick + 1) % sample_every == 0) {
-      push_sample(samples, q, dq);
-    }
+    if (sample_every > 0 && (tick + 1) % sample_every == 0) push_sample(samples, q, dq);
   }
   return finish(RolloutStatus::NotSettled, max_ticks);
 }
