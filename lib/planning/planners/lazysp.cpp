@@ -69,7 +69,9 @@ class LazySpSearch {
         s_(solve.context, solve.ws, solve.problem),
         set_(settings_of(solve.theta, solve.values)),
         h_scale_(ctx_.mean_displacement > 0 ? 1 + set_.edge_penalty / ctx_.mean_displacement : 1),
-        rng_(solve.problem.seed, kStream) {}
+        rng_(solve.problem.seed, kStream),
+        aims_at_configurations_(solve.problem.goal.kind != Goal::Kind::Joint &&
+                                !solve.problem.goal.configurations.empty()) {}
 
   // Beyond a bundle, the growth needs a sampling box.
   static void check_context(const PlanningContext& ctx, const ParameterValues&) {
@@ -96,6 +98,16 @@ class LazySpSearch {
   void found(int node, const char* by);
   std::vector<PathStep> path_to(int node);
   bool prunable(double g, double h);
+  // The lazy search's goal. For a pose goal or goal set (with configurations found by inverse
+  // kinematics): the joint distance to the nearest configuration, in the goal within theta of
+  // one, from where a validated candidate's end connects (connect_to_goal): the search is then
+  // as directed as for a joint goal, where the pose distance of predicted states is not (on the
+  // shelf, 529 ms median to a first solution against 37 ms for joint goals). Otherwise the
+  // goal's own heuristic and region.
+  double lazy_h(const JointVector& q);
+  bool lazy_in_goal(double h) const {
+    return aims_at_configurations_ ? h <= set_.theta : s_.in_goal(h);
+  }
   bool within_limits(const JointVector& q) const;
   uint64_t cell(const JointVector& q) const;
   // The bundle's P_collision (its build scene's), and in a marked search the scene's marks.
@@ -124,6 +136,7 @@ class LazySpSearch {
   // The heuristic counts the edge penalty too: h / mean displacement more edges to the goal.
   const double h_scale_;
   Random rng_;
+  const bool aims_at_configurations_;  // lazy_h
   bool goal_covered_ = true;
   std::unordered_set<uint64_t> tried_;  // (real node, edge) pairs simulated, valid or not
   std::vector<PathStep> commands_;      // the growth's commands, by LazySpNode::command
@@ -227,7 +240,7 @@ int LazySpSearch::search(size_t& expansions, size_t limit) {
     x.g = n.cost;
     x.length = n.cost;
     x.real = static_cast<int>(v);
-    push(x, n.h);
+    push(x, aims_at_configurations_ ? lazy_h(n.q) : n.h);
   }
   while (!open_.empty() && expansions < limit) {
     if (expansions % 8 == 0 && s_.out_of_time()) return -1;
@@ -265,7 +278,7 @@ int LazySpSearch::expand(int p) {
     const double displacement = step_.norm();  // a lower bound of the edge's arc length
     c.g = g + displacement + risk(e) + set_.edge_penalty;
     c.length = length + displacement;
-    const double h = s_.heuristic(next_);
+    const double h = lazy_h(next_);
     if (prunable(c.length, h)) continue;
     c.cell = cell(next_);
     if (!improves(c.cell, c.g)) continue;
@@ -274,7 +287,7 @@ int LazySpSearch::expand(int p) {
     c.edge = e;
     enqueue(std::move(c), h);
     ++s_.result().counters.lazy_edges;
-    if (s_.in_goal(h) && c.g < goal_g) {
+    if (lazy_in_goal(h) && c.g < goal_g) {
       goal = static_cast<int>(preds_.size()) - 1;
       goal_g = c.g;
     }
@@ -401,6 +414,14 @@ std::vector<PathStep> LazySpSearch::path_to(int node) {
 
 // After a solution, for joint goals: no state whose cost plus the least remaining arc length
 // cannot beat the best (as BoE).
+double LazySpSearch::lazy_h(const JointVector& q) {
+  if (!aims_at_configurations_) return s_.heuristic(q);
+  double nearest = std::numeric_limits<double>::infinity();
+  for (const JointVector& c : s_.problem().goal.configurations)
+    nearest = std::min(nearest, (c - q).norm());
+  return nearest;
+}
+
 bool LazySpSearch::prunable(double g, double h) {
   const PlanResult& r = s_.result();
   if (!r.success || s_.problem().goal.kind != Goal::Kind::Joint) return false;
