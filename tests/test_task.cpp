@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "cli_util.h"
+#include "lazyboe/bench/problems.h"
 #include "lazyboe/bundle/bundle_view.h"
 #include "lazyboe/common/error.h"
 #include "lazyboe/common/json_fields.h"
@@ -454,6 +455,40 @@ TEST(PoseGoal, InverseKinematicsReachesPosesOfTheRegion) {
     EXPECT_TRUE(((q.array() > f.robot.q_min.array()) && (q.array() < f.robot.q_max.array())).all());
   }
   EXPECT_GE(solved, 15);  // from one random seed each
+}
+
+// A study's problems file keeps pose goals and goal sets as they were read (lazyboe-bench
+// --problems-file repeats a study from it).
+TEST(PoseGoal, AStudysProblemsFileKeepsPoseGoalsAndSets) {
+  const Fixture& f = fixture();
+  Goal pose = pose_goal(f.robot, f.c);
+  pose.has_free_axis = true;
+  Goal joint;
+  joint.q = f.b;
+  joint.tolerance = kTolerance;
+  Goal set;
+  set.kind = Goal::Kind::Set;
+  set.members = {pose_goal(f.robot, f.b), joint};
+  set.tolerance = set.members[0].tolerance;
+  const std::vector<BenchProblem> written = {{"pose", f.a, pose}, {"set", f.a, set}};
+  const std::string path = fresh_dir("task-problems") + "/problems.jsonl";
+  write_problems(path, f.robot, written);
+  SimulatorWorkspace ws(f.sim);
+  const std::vector<BenchProblem> read = read_problems(path, f.sim, ws, QueryDefaults{});
+  ASSERT_EQ(read.size(), 2u);
+  const Goal& p = read[0].goal;
+  EXPECT_EQ(p.kind, Goal::Kind::Pose);
+  EXPECT_LT((p.position - pose.position).norm(), 1e-12);
+  EXPECT_LT(p.orientation.angularDistance(pose.orientation), 1e-9);
+  EXPECT_TRUE(p.has_free_axis);
+  EXPECT_EQ(p.tolerance, pose.tolerance);
+  EXPECT_EQ(p.orientation_tolerance, pose.orientation_tolerance);
+  const Goal& s = read[1].goal;
+  ASSERT_EQ(s.kind, Goal::Kind::Set);
+  ASSERT_EQ(s.members.size(), 2u);
+  EXPECT_EQ(s.members[0].kind, Goal::Kind::Pose);
+  EXPECT_EQ(s.members[1].kind, Goal::Kind::Joint);
+  EXPECT_EQ(s.members[1].q, f.b);
 }
 
 // ------------------------------------------------------------------------------------------

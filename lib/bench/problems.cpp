@@ -26,6 +26,36 @@ nlohmann::json vector_json(const JointVectorRef& q) {
   return std::vector<double>(q.data(), q.data() + q.size());
 }
 
+// A goal in the query format, every kind (a set: its members in order).
+nlohmann::json goal_json(const RobotModel& robot, const Goal& g) {
+  const auto vec3 = [](const Eigen::Vector3d& v) {
+    return std::vector<double>{v.x(), v.y(), v.z()};
+  };
+  switch (g.kind) {
+    case Goal::Kind::Joint:
+      return {{"q", vector_json(g.q)}, {"tolerance", g.tolerance}};
+    case Goal::Kind::Position:
+      return {{"position", vec3(g.position)},
+              {"link", robot.links[g.link].name},
+              {"tolerance", g.tolerance}};
+    case Goal::Kind::Pose: {
+      const Eigen::Quaterniond& o = g.orientation;
+      nlohmann::json pose = {{"position", vec3(g.position)},
+                             {"orientation", {o.w(), o.x(), o.y(), o.z()}},
+                             {"link", robot.links[g.link].name}};
+      if (g.has_free_axis) pose["free_axis"] = vec3(g.free_axis);
+      return {{"pose", pose},
+              {"position_tolerance", g.tolerance},
+              {"orientation_tolerance", g.orientation_tolerance}};
+    }
+    case Goal::Kind::Set:
+      break;
+  }
+  nlohmann::json members = nlohmann::json::array();
+  for (const Goal& m : g.members) members.push_back(goal_json(robot, m));
+  return members;
+}
+
 }  // namespace
 
 std::vector<BenchProblem> sample_problems(const Simulator& sim, SimulatorWorkspace& ws,
@@ -74,17 +104,9 @@ void write_problems(const std::string& path, const RobotModel& robot,
                     const std::vector<BenchProblem>& problems) {
   AtomicFile file(path);
   for (const BenchProblem& p : problems) {
-    nlohmann::json goal;
-    if (p.goal.kind == Goal::Kind::Joint) {
-      goal = {{"q", vector_json(p.goal.q)}, {"tolerance", p.goal.tolerance}};
-    } else {
-      goal = {{"position", {p.goal.position.x(), p.goal.position.y(), p.goal.position.z()}},
-              {"link", robot.links[p.goal.link].name},
-              {"tolerance", p.goal.tolerance}};
-    }
-    file.stream()
-        << nlohmann::json{{"id", p.id}, {"start", vector_json(p.start)}, {"goal", goal}}.dump()
-        << "\n";
+    const nlohmann::json line = {
+        {"id", p.id}, {"start", vector_json(p.start)}, {"goal", goal_json(robot, p.goal)}};
+    file.stream() << line.dump() << "\n";
   }
   file.commit();
 }
