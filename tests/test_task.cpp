@@ -159,7 +159,7 @@ PlanRequest request(const std::string& planner, const JointVectorRef& start,
   r.problem.start = start;
   r.problem.goal.q = goal;
   r.problem.goal.tolerance = kTolerance;
-  r.problem.termination.budget = 10 * time_scale();
+  r.problem.termination.budget = 60 * time_scale();  // stops at the first solution
   r.problem.termination.stop_at_first = true;
   r.output.sample_interval = 0.001;  // every control tick, for the checks
   return r;
@@ -363,7 +363,7 @@ PlanRequest goal_request(const std::string& planner, const JointVectorRef& start
   if (search) r.parameters = searching(planner);
   r.problem.start = start;
   r.problem.goal = std::move(goal);
-  r.problem.termination.budget = 10 * time_scale();
+  r.problem.termination.budget = 60 * time_scale();  // stops at the first solution
   r.problem.termination.stop_at_first = true;
   return r;
 }

@@ -96,10 +96,6 @@ bool out_of_reach(const RobotModel& robot, const Goal& g) {
   return (g.position - shoulder).norm() > reach + g.tolerance;
 }
 
-}  // namespace
-
-namespace {
-
 // A goal position inside an obstacle's solid: no link origin can get there.
 ProblemIssue inside_obstacle(const Simulator& sim, SimulatorWorkspace& ws, const std::string& field,
                              const Eigen::Vector3d& position) {
