@@ -21,6 +21,15 @@ PoseTarget Goal::pose_target() const {
   return t;
 }
 
+std::pair<const JointVector*, double> Goal::nearest_configuration(const JointVectorRef& q) const {
+  std::pair<const JointVector*, double> best{nullptr, std::numeric_limits<double>::infinity()};
+  for (const JointVector& c : configurations) {
+    const double d = (c - q).norm();
+    if (d < best.second) best = {&c, d};
+  }
+  return best;
+}
+
 double Goal::distance(const RobotModel& robot, RobotData& data, const JointVectorRef& state) const {
   switch (kind) {
     case Kind::Joint:

@@ -43,6 +43,9 @@ struct Goal {
   int reached = 0, attempts = 0;
 
   PoseTarget pose_target() const;  // Position, Pose
+  // The configuration nearest q (Euclidean in joint space) and its distance; null and infinity
+  // when there is none.
+  std::pair<const JointVector*, double> nearest_configuration(const JointVectorRef& q) const;
   // Heuristic, in the unit of `tolerance`: the joint-space distance to q; the Cartesian
   // distance of the link to the position; for a pose the larger of the position error and the
   // orientation error weighted by tolerance / orientation_tolerance (so that the region is

@@ -66,7 +66,6 @@ class SearchState {
         goal_data_(ctx.sim.robot) {}
 
   const PlanningContext& context() const { return ctx_; }
-  SimulatorWorkspace& workspace() { return ws_; }
   const PlanningProblem& problem() const { return problem_; }
   std::vector<Node>& nodes() { return nodes_; }
   Node& node(int v) { return nodes_[v]; }
@@ -137,12 +136,8 @@ class SearchState {
   // simulates valid; `simulations` gets how many it ran (all counted here).
   std::optional<PathStep> goal_connection(const JointVector& q, int& simulations) {
     simulations = 0;
-    const std::vector<JointVector>& targets = problem_.goal.configurations;
-    if (targets.empty()) return std::nullopt;
-    const JointVector* nearest = &targets.front();
-    for (const JointVector& t : targets)
-      if ((t - q).norm() < (*nearest - q).norm()) nearest = &t;
-    if ((*nearest - q).norm() > kGoalConnectRadius) return std::nullopt;
+    const auto [nearest, distance] = problem_.goal.nearest_configuration(q);
+    if (!nearest || distance > kGoalConnectRadius) return std::nullopt;
     std::optional<PathStep> step =
         direct_step_to(ctx_.sim, ws_, ctx_.command, q, *nearest, &problem_.goal, &simulations);
     if (!step) return std::nullopt;

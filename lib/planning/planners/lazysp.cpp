@@ -416,10 +416,7 @@ std::vector<PathStep> LazySpSearch::path_to(int node) {
 // cannot beat the best (as BoE).
 double LazySpSearch::lazy_h(const JointVector& q) {
   if (!aims_at_configurations_) return s_.heuristic(q);
-  double nearest = std::numeric_limits<double>::infinity();
-  for (const JointVector& c : s_.problem().goal.configurations)
-    nearest = std::min(nearest, (c - q).norm());
-  return nearest;
+  return s_.problem().goal.nearest_configuration(q).second;
 }
 
 bool LazySpSearch::prunable(double g, double h) {

@@ -51,9 +51,9 @@ PlanResult TreeSearch::run() {
     commands_.push_back({-1, knots, duration});
     const int id = add(c, from);
     added(id);
-    if (s_.in_goal(c.h) || connect(id)) {
-      s_.solution(s_.in_goal(c.h) ? id : static_cast<int>(s_.nodes().size()) - 1,
-                  [this](int u) { return path_to(u); });
+    const int in_goal = s_.in_goal(c.h) ? id : connect(id);
+    if (in_goal >= 0) {
+      s_.solution(in_goal, [this](int u) { return path_to(u); });
       if (stop_at_solution()) break;
     }
   }
@@ -78,20 +78,21 @@ void sample_state(const PlanningContext& ctx, const PlanningProblem& p, double g
 }
 
 // Pose goals and goal sets: the direct command from node v into the goal
-// (SearchState::goal_connection); true when it reached it (the goal node added last).
-bool TreeSearch::connect(int v) {
+// (SearchState::goal_connection); the node it reached in the goal, or -1.
+int TreeSearch::connect(int v) {
   int simulations = 0;
   std::optional<PathStep> step = s_.goal_connection(s_.node(v).q, simulations);
-  if (!step) return false;
+  if (!step) return -1;
   TreeNode g;
   g.reached(*step->outcome, s_.node(v).cost);
   g.parent = v;
   g.h = s_.heuristic(g.q);
-  if (!s_.in_goal(g.h)) return false;
+  if (!s_.in_goal(g.h)) return -1;
   g.command = static_cast<int>(commands_.size());
   commands_.push_back({-1, std::move(step->knots), step->command_duration});
-  added(add(g, v));
-  return true;
+  const int id = add(g, v);
+  added(id);
+  return id;
 }
 
 void TreeSearch::sample(JointVector& x) { sample_state(ctx_, s_.problem(), goal_bias_, rng_, x); }

@@ -73,7 +73,7 @@ class TreeSearch {
 
  private:
   void sample(JointVector& x);
-  bool connect(int v);
+  int connect(int v);  // the goal node, or -1
   int add(TreeNode c, int from);
   std::vector<PathStep> path_to(int node);
 
