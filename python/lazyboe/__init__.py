@@ -27,13 +27,17 @@ from ._lazyboe import (  # noqa: F401
     perturb_bundle,
     planners,
 )
+from .task import EndEffectorLimits, Payload, Pose  # noqa: F401
 
 __all__ = [
     "Bundle",
     "CollisionChecker",
+    "EndEffectorLimits",
     "Environment",
+    "Payload",
     "PlanningSession",
     "PlanResult",
+    "Pose",
     "Robot",
     "Scene",
     "Trajectory",

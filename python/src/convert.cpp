@@ -104,6 +104,8 @@ nlohmann::json to_json(const py::handle& value, const std::string& where) {
   }
   if (py::isinstance<py::float_>(value)) return value.cast<double>();
   if (py::isinstance<py::str>(value)) return value.cast<std::string>();
+  // lazyboe.Pose, Payload, EndEffectorLimits (lazyboe/task.py): the query format's object.
+  if (py::hasattr(value, "to_query")) return to_json(value.attr("to_query")(), where);
   if (py::isinstance<py::dict>(value)) {
     nlohmann::json j = nlohmann::json::object();
     for (const auto& [k, v] : value.cast<py::dict>()) {

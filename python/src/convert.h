@@ -75,8 +75,9 @@ py::array_t<double> to_array(const std::vector<double>& v);
 py::array_t<double> rows_to_array(const std::vector<JointVector>& rows, int cols);
 std::vector<double> to_vector(const JointVectorRef& v);
 
-// Python values (dict, list, tuple, str, bool, int, float, None, NumPy arrays and scalars) as
-// JSON, for the query format; throws InputError naming `where` for anything else.
+// Python values (dict, list, tuple, str, bool, int, float, None, NumPy arrays and scalars, and
+// objects with to_query(), as lazyboe.Pose) as JSON, for the query format; throws InputError
+// naming `where` for anything else.
 nlohmann::json to_json(const py::handle& value, const std::string& where);
 py::object from_json(const nlohmann::json& value);
 

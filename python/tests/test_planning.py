@@ -160,6 +160,31 @@ def test_pose_goal_and_the_task_at_query_time(session, tmp_path):
         session.plan(START, goal, payload={"mass": -1})
 
 
+def test_typed_task_objects_are_the_query_format(session):
+    """lazyboe.Pose, Payload and EndEffectorLimits plan as their dicts do (same seed, same
+    answer), and a free yaw about the tool axis is reached within tolerance otherwise."""
+    robot = session.robot
+    pose = robot.forward_kinematics(GOAL)
+    goal = lazyboe.Pose.from_matrix(pose, free_axis=[0, 0, 1], orientation_tolerance=0.05)
+    assert goal.to_query()["pose"]["orientation"] == pytest.approx(quaternion(pose[:3, :3]))
+    payload = lazyboe.Payload(1.0, com=[0, 0, 0.1], box=[0.05, 0.05, 0.1])
+    limits = lazyboe.EndEffectorLimits(max_linear_acceleration=3.0, max_tilt=1.0)
+    options = dict(planner="lazysp", seed=2, stop_at_first=True, budget=20)
+    typed = session.plan(START, goal, payload=payload, end_effector_limits=limits, **options)
+    plain = session.plan(START, goal.to_query(), payload=payload.to_query(),
+                         end_effector_limits=limits.to_query(), **options)
+    assert typed.success, typed.failure
+    assert np.array_equal(typed.trajectory.q, plain.trajectory.q)
+    end = robot.forward_kinematics(typed.trajectory.q[-1])
+    assert np.linalg.norm(end[:3, 3] - pose[:3, 3]) <= 0.01
+    # Only a rotation about the tool's z axis is free: that axis ends where the goal has it.
+    assert np.arccos(np.clip(end[:3, 2] @ pose[:3, 2], -1, 1)) <= 0.05
+    with pytest.raises(ValueError, match="orientation: expected 4 numbers"):
+        lazyboe.Pose([0.5, 0, 0.5], [1, 0, 0])
+    with pytest.raises(ValueError, match="payload.mass"):
+        session.plan(START, goal, payload=lazyboe.Payload(-1.0))
+
+
 def quaternion(m):
     """[w, x, y, z] of a rotation matrix (w >= 0)."""
     w = np.sqrt(max(0.0, 1 + m[0, 0] + m[1, 1] + m[2, 2])) / 2
