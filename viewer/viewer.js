@@ -263,21 +263,41 @@
       return o;
     });
     robotLayer.add(group);
+    let payload = null;  // {box: the mesh, link, at: its pose on the link}
+    let lastQ = null;
     return {
       group: group,
       setQ(q) {
         if (layer !== MOVING_LAYER) stillLayers.changed();
+        lastQ = q;
         const poses = linkPoses(robot, q);
         robot.shapes.forEach((s, i) => setMatrix(parts[i], compose(poses[s.link], s.pose)));
+        if (payload) setMatrix(payload.box, compose(poses[payload.link], payload.at));
       },
+      // The query's payload as a box at its centre of mass on its link (default the tip), or
+      // none (p null).
+      setPayload(p) {
+        if (payload) { group.remove(payload.box); payload.box.geometry.dispose(); payload = null; }
+        if (!p) return;
+        const link = p.link === undefined ? robot.tip : robot.links.findIndex((l) => l.name === p.link);
+        if (link < 0) { say('payload.link: unknown link ' + p.link + ': the payload is not drawn'); return; }
+        const box = new THREE.Mesh(new THREE.BoxBufferGeometry(p.box[0], p.box[1], p.box[2]), payloadMaterial);
+        box.layers.set(layer);
+        group.add(box);
+        payload = {box: box, link: link, at: {R: [1, 0, 0, 0, 1, 0, 0, 0, 1], p: p.com}};
+        if (lastQ) this.setQ(lastQ);
+      },
+      payloadPosition() { return payload ? payload.box.matrix.elements.slice(12, 15) : null; },
     };
   }
+  const payloadMaterial = new THREE.MeshLambertMaterial({color: 0x8a6d3b});
   const mainRobot = makeRobot(0xe09040, 1, MOVING_LAYER);
   const startGhost = makeRobot(0x30a050, 0.3, 0);
-  const goalGhost = makeRobot(0xc03030, 0.3, 0);
-  const goalRegion = new THREE.Mesh(new THREE.SphereBufferGeometry(1, 24, 16),
-                                    new THREE.MeshLambertMaterial({color: 0xc03030, transparent: true, opacity: 0.3}));
-  scene.add(goalRegion);
+  const goalGhosts = [makeRobot(0xc03030, 0.3, 0)];  // more are made when a goal set needs them
+  const goalMarks = new THREE.Group();  // tolerance spheres and pose axes, remade per selection
+  scene.add(goalMarks);
+  const goalSphere = new THREE.SphereBufferGeometry(1, 24, 16);
+  const goalMaterial = new THREE.MeshLambertMaterial({color: 0xc03030, transparent: true, opacity: 0.3});
 
   const obstacleMaterial = new THREE.MeshLambertMaterial({color: 0x7088a8});
   for (const o of data.environment.obstacles) {
@@ -354,17 +374,48 @@
   $('failure-count').textContent = '(' + failures.length + ')';
   $('failure-section').hidden = failures.length === 0;
 
-  // Ghosts at a query's start and goal (a goal in joint space, or a position with its tolerance).
-  function showEnds(start, goal) {
-    startGhost.group.visible = !!start;
-    if (start) startGhost.setQ(start);
-    goalGhost.group.visible = !!(goal && goal.q);
-    if (goal && goal.q) goalGhost.setQ(goal.q);
-    goalRegion.visible = !!(goal && goal.position);
-    if (goal && goal.position) {
-      goalRegion.position.set(goal.position[0], goal.position[1], goal.position[2]);
-      goalRegion.scale.setScalar(goal.tolerance || 0.02);
+  // A query's goal: a ghost per joint goal, a sphere of the position tolerance per position or
+  // pose goal, and per pose goal its frame as axes (x red, y green, z blue, 10 cm); every
+  // member of a goal set.
+  function showGoal(goal) {
+    for (const o of goalMarks.children.slice()) {
+      goalMarks.remove(o);
+      if (o instanceof THREE.AxesHelper) o.geometry.dispose();
     }
+    goalGhosts.forEach((g) => { g.group.visible = false; });
+    let ghosts = 0;
+    for (const g of !goal ? [] : goal.set || [goal]) {
+      if (g.q) {
+        if (ghosts === goalGhosts.length) goalGhosts.push(makeRobot(0xc03030, 0.3, 0));
+        goalGhosts[ghosts].group.visible = true;
+        goalGhosts[ghosts++].setQ(g.q);
+      }
+      const p = g.pose ? g.pose.p : g.position;
+      if (p) {
+        const sphere = new THREE.Mesh(goalSphere, goalMaterial);
+        sphere.position.set(p[0], p[1], p[2]);
+        sphere.scale.setScalar(g.tolerance || (g.pose ? 0.01 : 0.02));
+        goalMarks.add(sphere);
+      }
+      if (g.pose) {
+        const axes = new THREE.AxesHelper(0.1);
+        setMatrix(axes, g.pose);
+        goalMarks.add(axes);
+      }
+    }
+  }
+  // Ghosts at a query's start and goal, and its payload on the robot and the start ghost.
+  function showEnds(start, goal, payload) {
+    startGhost.group.visible = !!start;
+    for (const r of [mainRobot, startGhost]) r.setPayload(payload || null);
+    if (start) startGhost.setQ(start);
+    showGoal(goal);
+  }
+  // What showGoal and setPayload drew for the selection (the tests read it).
+  function goalView() {
+    const count = (type) => goalMarks.children.filter((o) => o instanceof type).length;
+    return {ghosts: goalGhosts.filter((g) => g.group.visible).length, spheres: count(THREE.Mesh),
+            axes: count(THREE.AxesHelper), payload: mainRobot.payloadPosition()};
   }
 
   // ---- Playback -------------------------------------------------------------------------
@@ -401,7 +452,7 @@
       play.selected = tr;
       tr.row.classList.add('selected');
       const q = tr.samples.q;
-      showEnds(tr.start || q[0], tr.goal || {q: q[q.length - 1]});
+      showEnds(tr.start || q[0], tr.goal || {q: q[q.length - 1]}, tr.payload);
       mainRobot.group.visible = true;
       selectedPath.geometry.dispose();
       selectedPath.geometry = new THREE.BufferGeometry();
@@ -419,7 +470,7 @@
       play.playing = false;
       selectedPath.visible = false;
       f.row.classList.add('selected');
-      showEnds(f.start, f.goal);
+      showEnds(f.start, f.goal, f.payload);
       mainRobot.group.visible = !f.start;  // the start ghost stands for the robot
       $('selected-info').textContent = (f.id === null ? '(no id)' : f.id) + ' (' + (f.planner || '-') + ', line ' +
         f.line + '): ' + f.kind + ': ' + f.reason;
@@ -556,6 +607,7 @@
     play() { if (!play.playing) $('play').click(); },
     setSpeed(s) { play.speed = s; },
     select: select,
+    goalView: goalView,
     messages: messages,
     renderer: rendererName,
     stillLayersCached: stillLayers.cached,

@@ -125,7 +125,8 @@ namespace {
 
 struct QueryEnds {
   std::string id;
-  json start, goal;  // goal: {q} or {position}, with its tolerance when given
+  json start, goal;  // goal: one goal_marks, or {"set": [goal_marks, ...]}
+  json payload;      // {link, com, box} or null
 };
 
 // A joint vector of the robot's size, as the page's kinematics needs it.
@@ -136,9 +137,57 @@ json joint_vector(const JsonField& field, int dof) {
   return v;
 }
 
-// Start and goal of each query line (1-based). Only what the page draws is read (lazyboe-query
-// has checked the rest), but that strictly: a line that is not JSON, a start or goal.q of the
-// wrong size, a goal.position that is not 3 numbers are errors naming the line and field.
+// What the page draws of one goal: {q}, {position, link} or {pose: {R, p}, link}, with the
+// (position) tolerance when given.
+json goal_marks(const JsonField& goal, int dof) {
+  json g = json::object();
+  if (goal.has("q")) g["q"] = joint_vector(goal.at("q"), dof);
+  if (goal.has("position")) {
+    const Eigen::Vector3d p = goal.at("position").vec3();
+    g["position"] = {p.x(), p.y(), p.z()};
+  }
+  if (goal.has("tolerance")) g["tolerance"] = goal.at("tolerance").positive();
+  if (goal.has("pose")) {
+    const JsonField pose = goal.at("pose");
+    const std::vector<double> w = pose.at("orientation").numbers();
+    if (w.size() != 4) pose.at("orientation").fail("expected 4 numbers [w, x, y, z]");
+    const Eigen::Quaterniond quaternion(w[0], w[1], w[2], w[3]);
+    if (!(quaternion.norm() > 1e-9)) pose.at("orientation").fail("must not be zero");
+    g["pose"] = pose_json(Pose{quaternion.normalized().toRotationMatrix(),
+                               pose.at("position").vec3()});
+    if (pose.has("link")) g["link"] = pose.at("link").string();
+    if (goal.has("position_tolerance"))
+      g["tolerance"] = goal.at("position_tolerance").positive();
+  } else if (goal.has("link")) {
+    g["link"] = goal.at("link").string();
+  }
+  return g;
+}
+
+// The goal of a query line: one goal, or a set of them ("goal": [...]).
+json goal_view(const nlohmann::json& value, const JsonField& goal, int dof) {
+  if (value.is_object()) return goal_marks(goal, dof);
+  if (!value.is_array() || value.empty()) goal.fail("expected an object or a list of goals");
+  json set = json::array();
+  for (const JsonField& member : goal.items()) set.push_back(goal_marks(member, dof));
+  return {{"set", set}};
+}
+
+// A payload as the page draws it: a box (its own, or 5 cm for a point mass) at its centre of
+// mass, on its link.
+json payload_view(const JsonField& payload) {
+  const Eigen::Vector3d com = payload.has("com") ? payload.at("com").vec3() : Eigen::Vector3d{};
+  const Eigen::Vector3d box =
+      payload.has("box") ? payload.at("box").vec3() : Eigen::Vector3d::Constant(0.05);
+  json p = {{"com", {com.x(), com.y(), com.z()}}, {"box", {box.x(), box.y(), box.z()}}};
+  if (payload.has("link")) p["link"] = payload.at("link").string();
+  return p;
+}
+
+// Start, goal and payload of each query line (1-based). Only what the page draws is read
+// (lazyboe-query has checked the rest), but that strictly: a line that is not JSON, a start or
+// goal.q of the wrong size, a goal.position that is not 3 numbers are errors naming the line
+// and field.
 std::map<int, QueryEnds> read_query_ends(const std::string& path, int dof) {
   require_input_file(path, "queries");
   std::ifstream in(path);
@@ -153,15 +202,8 @@ std::map<int, QueryEnds> read_query_ends(const std::string& path, int dof) {
     QueryEnds e;
     if (value.contains("id") && value["id"].is_string()) e.id = value["id"];
     e.start = joint_vector(q.at("start"), dof);
-    const JsonField goal = q.at("goal");
-    if (!value["goal"].is_object()) goal.fail("expected an object");
-    e.goal = json::object();
-    if (goal.has("q")) e.goal["q"] = joint_vector(goal.at("q"), dof);
-    if (goal.has("position")) {
-      const Eigen::Vector3d p = goal.at("position").vec3();
-      e.goal["position"] = {p.x(), p.y(), p.z()};
-    }
-    if (goal.has("tolerance")) e.goal["tolerance"] = goal.at("tolerance").positive();
+    e.goal = goal_view(value["goal"], q.at("goal"), dof);
+    if (q.has("payload")) e.payload = payload_view(q.at("payload"));
     out[line] = e;
   }
   return out;
@@ -291,6 +333,7 @@ class ResultsReader {
                       "' of line " + std::to_string(line) + " of " + options_.queries_path);
     item["start"] = it->second.start;
     item["goal"] = it->second.goal;
+    item["payload"] = it->second.payload;
   }
 
   std::string path_;

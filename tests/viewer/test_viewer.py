@@ -170,6 +170,48 @@ def compare_fk(browser, bin_dir, configurations):
           f"configurations, every link (largest difference {worst:.1e})")
 
 
+def rotate(quaternion, v):
+    """v rotated by the unit quaternion [w, x, y, z]."""
+    w, x, y, z = quaternion
+    u = (x, y, z)
+    t = [2 * (u[1] * v[2] - u[2] * v[1]), 2 * (u[2] * v[0] - u[0] * v[2]), 2 * (u[0] * v[1] - u[1] * v[0])]
+    return [v[i] + w * t[i] + (u[(i + 1) % 3] * t[(i + 2) % 3] - u[(i + 2) % 3] * t[(i + 1) % 3])
+            for i in range(3)]
+
+
+def task_page(bin_dir, out_dir):
+    """A pose goal with a payload (line 1) and a goal set of a joint, a position and a pose goal
+    (line 2), as issue 29's queries have them."""
+    tool = os.path.join(bin_dir, "lazyboe-view")
+    pose = {"pose": {"position": [0.4, 0.1, 0.5], "orientation": [0, 1, 0, 0]}, "position_tolerance": 0.02}
+    queries = write_lines(os.path.join(out_dir, "task-queries.jsonl"), [
+        {"id": "pose", "start": READY, "goal": pose, "payload": {"mass": 2.0, "com": [0, 0, 0.08]}},
+        {"id": "set", "start": OTHER, "goal": [{"q": THIRD}, {"position": [0.3, -0.3, 0.4]}, pose]}])
+    results = write_lines(os.path.join(out_dir, "task-results.jsonl"), [
+        trajectory_result("pose", 1, READY, OTHER), trajectory_result("set", 2, OTHER, THIRD)])
+    page = os.path.join(out_dir, "task.html")
+    run([tool, "--results", results, "--queries", queries, "--out", page])
+    return page
+
+
+def check_task_page(browser, bin_dir, page):
+    """Goal frames and goal sets drawn; the payload box at the tip's centre of mass (fk)."""
+    open_page(browser, page, "task page")
+    browser.evaluate("lazyboeView.select('trajectory', 0)")
+    view = json.loads(browser.evaluate("JSON.stringify(lazyboeView.goalView())"))
+    tip = json.loads(run([os.path.join(bin_dir, "lazyboe-robot"), "fk", "--q", ",".join(map(repr, READY))]))
+    at = [p + d for p, d in zip(tip["position"], rotate(tip["quaternion"], [0, 0, 0.08]))]
+    check(view["axes"] == 1 and view["spheres"] == 1 and view["ghosts"] == 0,
+          f"task page: a pose goal is drawn as its frame and tolerance sphere ({view})")
+    check(view["payload"] is not None and max(abs(a - b) for a, b in zip(view["payload"], at)) < 1e-6,
+          f"task page: the payload box sits at the tip's centre of mass at the start ({view['payload']} vs {at})")
+    browser.evaluate("lazyboeView.select('trajectory', 1)")
+    view = json.loads(browser.evaluate("JSON.stringify(lazyboeView.goalView())"))
+    check(view == {"ghosts": 1, "spheres": 2, "axes": 1, "payload": None},
+          f"task page: every member of a goal set is drawn, no payload without one ({view})")
+    check(not browser.console_errors, f"task page: no console errors {browser.console_errors}")
+
+
 def obstacles_in(env_path):
     with open(env_path) as f:
         env = json.load(f)
@@ -228,6 +270,7 @@ def main():
     files_scene, files_obstacles = scene_with_files(out_dir)
     files_page = os.path.join(out_dir, "files.html")
     run([tool, "--results", results, "--queries", queries, "--env", files_scene, "--out", files_page])
+    goals_page = task_page(bin_dir, out_dir)
     no_trajectories = os.path.join(out_dir, "none.html")
     bare = trajectory_result("a", 1, READY, OTHER)
     del bare["trajectory"]
@@ -274,6 +317,8 @@ def main():
         check(state.get("obstacles") == str(files_obstacles) and "mesh" in types and "cells" in types,
               f"mesh and point-cloud page: every obstacle, the mesh and the cloud's cells drawn ({types})")
         nonblank_robot(browser, os.path.join(out_dir, "files.png"), "mesh and point-cloud page")
+
+        check_task_page(browser, bin_dir, goals_page)
 
         state = open_page(browser, only_failed, "failed-only page")
         text = browser.evaluate("document.body.innerText")
