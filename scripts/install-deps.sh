@@ -9,6 +9,8 @@ packages=(
   nlohmann-json3-dev
   # Obstacles given as meshes and point clouds (Assimp) and as OctoMap octrees (issue 26).
   libassimp-dev liboctomap-dev
+  # The k-d tree over the bundle's edge end poses, pose goals' coverage (issue 29).
+  libnanoflann-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   python3 python3-jsonschema
   # The Python module (python/) and its tests: built for and run by Debian's /usr/bin/python3.

@@ -22,6 +22,7 @@
 #include "lazyboe/common/error.h"
 #include "lazyboe/common/json_fields.h"
 #include "lazyboe/io/query_io.h"
+#include "lazyboe/planning/end_pose_index.h"
 #include "lazyboe/planning/planning_session.h"
 #include "lazyboe/planning/request.h"
 #include "lazyboe/planning/world.h"
@@ -191,7 +192,7 @@ TEST(Payload, ReturnedTrajectoriesValidateWithThePayload) {
   task.payload = payload_of(f.robot, {{"mass", 3.0}, {"com", {0, 0, 0.3}}});
   const TaskWorld loaded(f, task);
   SimulatorWorkspace ws(loaded.world.sim);
-  for (const std::string& planner : {"lazysp", "lazyboe", "rrt"}) {
+  for (const std::string planner : {"lazysp", "lazyboe", "rrt"}) {
     const PlanAnswer a = answer_request(loaded.context, request(planner, f.a, f.c), ws);
     ASSERT_TRUE(a.result.success) << planner << ": " << a.result.failure;
     const TrajectoryCheckResult r = check(loaded.world, a.trajectory);
@@ -285,7 +286,7 @@ TEST(EndEffectorLimits, EverySampleOfAReturnedTrajectoryKeepsThem) {
   SimulatorWorkspace ws(waiter.world.sim);
   // The tilt of the goal from the start's vertical: within the limit (else the goal is refused).
   ASSERT_EQ(check_state(waiter.world.sim, ws, f.b), RolloutStatus::Valid);
-  for (const std::string& planner : {"lazysp", "boe"}) {
+  for (const std::string planner : {"lazysp", "boe"}) {
     const PlanAnswer a = answer_request(waiter.context, request(planner, f.a, f.b), ws);
     ASSERT_TRUE(a.result.success) << planner << ": " << a.result.failure;
     EXPECT_EQ(end_effector_violations(waiter.world.robot, a.trajectory, task.end_effector), "")
@@ -381,7 +382,9 @@ TEST(PoseGoal, TheReturnedTrajectoryEndsAtRestWithinBothTolerances) {
     EXPECT_LE(position, 0.01) << planner << " search " << search;
     EXPECT_LE(orientation, 0.05) << planner << " search " << search;
     EXPECT_LE(a.trajectory.dq.back().cwiseAbs().maxCoeff(), f.sim.options.settle_velocity);
-    if (planner == "lazysp") EXPECT_EQ(a.result.found_by, search ? "connection" : "direct");
+    if (planner == "lazysp") {
+      EXPECT_EQ(a.result.found_by, search ? "connection" : "direct");
+    }
   }
 }
 
@@ -395,7 +398,7 @@ TEST(PoseGoal, AFreeAxisAcceptsAnyRotationAboutItAndNoOther) {
     goal.orientation = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) * held;
     EXPECT_TRUE(goal.contains(f.robot, d, f.c)) << "yaw " << yaw;
   }
-  for (const Eigen::Vector3d& axis : {Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY()}) {
+  for (const Eigen::Vector3d axis : {Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY()}) {
     goal.orientation = Eigen::AngleAxisd(0.1, axis) * held;
     EXPECT_FALSE(goal.contains(f.robot, d, f.c)) << axis.transpose();
     EXPECT_NEAR(tip_errors(f.robot, f.c, goal).second, 0.1, 1e-9);
@@ -455,6 +458,66 @@ TEST(PoseGoal, InverseKinematicsReachesPosesOfTheRegion) {
     EXPECT_TRUE(((q.array() > f.robot.q_min.array()) && (q.array() < f.robot.q_max.array())).all());
   }
   EXPECT_GE(solved, 15);  // from one random seed each
+}
+
+// The end-pose index answers as a scan would: the `count` edges whose end poses are nearest a
+// pose (by the pose goals' heuristic) among the kCandidates nearest by position.
+TEST(PoseGoal, TheEndPoseIndexFindsTheEdgesEndingNearestAPose) {
+  const Fixture& f = fixture();
+  const EndPoseIndex ends(f.view, f.robot, f.robot.tip_link());
+  ASSERT_EQ(ends.size(), f.view.size());
+  RobotData d(f.robot);
+  std::vector<std::pair<double, uint32_t>> by_position(f.view.size());
+  std::vector<uint32_t> found;
+  for (const size_t probe : {size_t{3}, f.view.size() / 2}) {
+    Goal g = pose_goal(f.robot, Eigen::Map<const JointVector>(f.view.qf(probe), 7));
+    g.position.x() += 0.02;  // off the probe's own end
+    const PoseTarget target = g.pose_target();
+    for (size_t e = 0; e < f.view.size(); ++e) {
+      forward_kinematics(f.robot, d, Eigen::Map<const JointVector>(f.view.qf(e), 7));
+      by_position[e] = {(link_pose(f.robot, d, target.link).p - target.position).norm(), e};
+    }
+    std::sort(by_position.begin(), by_position.end());
+    std::vector<std::pair<double, uint32_t>> ranked;
+    for (size_t i = 0; i < EndPoseIndex::kCandidates; ++i) {
+      const uint32_t e = by_position[i].second;
+      forward_kinematics(f.robot, d, Eigen::Map<const JointVector>(f.view.qf(e), 7));
+      const PoseError error = pose_error(target, link_pose(f.robot, d, target.link));
+      const double weight = target.position_tolerance / target.orientation_tolerance;
+      ranked.emplace_back(std::max(error.position, error.orientation * weight), e);
+    }
+    std::sort(ranked.begin(), ranked.end());
+    ends.nearest(target, 8, found);
+    ASSERT_EQ(found.size(), 8u);
+    for (size_t i = 0; i < found.size(); ++i) EXPECT_EQ(found[i], ranked[i].second) << i;
+  }
+}
+
+// With the bundle's end poses, a pose goal's configurations are ones the bundle reaches: near
+// an edge's end state (IK from the nearest end moves it little), which random seeds mostly are not.
+TEST(PoseGoal, ConfigurationsFromTheEndPoseIndexLieInTheBundlesCoverage) {
+  const Fixture& f = fixture();
+  const EndPoseIndexes coverage(f.view, f.robot);
+  const EdgeIndex ends(f.view, EdgePoint::End);
+  SimulatorWorkspace ws(f.sim);
+  std::vector<std::pair<uint32_t, double>> near;
+  int covered[2] = {0, 0};  // without, with the index
+  for (size_t probe = 5; probe < f.view.size(); probe += f.view.size() / 10) {
+    Goal g = pose_goal(f.robot, Eigen::Map<const JointVector>(f.view.qf(probe), 7));
+    g.position.z() += 0.01;
+    for (int with = 0; with < 2; ++with) {
+      resolve_goal(f.sim, ws, f.a, 1, g, with ? &coverage : nullptr);
+      ASSERT_FALSE(g.configurations.empty());
+      bool any = false;
+      for (const JointVector& q : g.configurations) {
+        ends.within(q.data(), 0.05, near);
+        any = any || !near.empty();
+      }
+      covered[with] += any;
+    }
+  }
+  EXPECT_GE(covered[1], 9);  // 10 of 10 when written; without the index 3
+  EXPECT_LE(covered[0], 6);
 }
 
 // A study's problems file keeps pose goals and goal sets as they were read (lazyboe-bench

@@ -230,7 +230,8 @@ Query read_query(const nlohmann::json& doc, const std::string& where, const Simu
   q.world = parse_task(root, sim, ws, q.world ? q.world : base, scenes, q.request.problem.start);
   const Simulator& in = q.world ? q.world->sim : sim;
   PlanningProblem& p = q.request.problem;
-  if (needs_configurations(p.goal)) resolve_goal(in, ws, p.start, p.seed, p.goal);
+  if (needs_configurations(p.goal))
+    resolve_goal(in, ws, p.start, p.seed, p.goal, scenes ? scenes->goal_coverage() : nullptr);
   const ProblemIssue issue = find_problem_issue(in, ws, q.request.problem);
   if (issue.any()) fail(where.empty() ? issue.field : where + ": " + issue.field, issue.what);
   return q;

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "lazyboe/bundle/bundle_view.h"
+#include "lazyboe/planning/end_pose_index.h"
 #include "lazyboe/planning/neighbour_index.h"
 #include "lazyboe/planning/problem.h"
 #include "lazyboe/planning/workspace_index.h"
@@ -36,6 +37,8 @@ struct PlanningContext {
   // The bundle edges the world may block (its workspace-index marks), when the world is not the
   // bundle's own scene; null: the bundle's P_collision (its build scene's) is the prior.
   const EdgeMarks* scene_marks = nullptr;
+  // The bundle's edge end poses (pose goals' coverage: resolve_goal's seeds); null: none.
+  const EndPoseIndexes* end_poses = nullptr;
 };
 
 // The prior probability that bundle edge `e` collides in the context's world: 1 for an edge an

@@ -56,9 +56,11 @@ WorldPtr default_world(const BundleHeader& h, const RobotModel& robot,
 // The session's worlds: its default, and every later one, marked by one marker.
 SceneCache session_scenes(const BundleHeader& h, const RobotModel& robot,
                           const SimulationOptions& options, const std::string& env_path,
-                          const WorkspaceIndexLoad& workspace) {
+                          const WorkspaceIndexLoad& workspace,
+                          const EndPoseIndexes& goal_coverage) {
   const EdgeMarker marker = session_marker(workspace, robot, h);
-  return SceneCache(robot, options, default_world(h, robot, options, env_path, marker), marker);
+  return SceneCache(robot, options, default_world(h, robot, options, env_path, marker), marker,
+                    &goal_coverage);
 }
 
 }  // namespace
@@ -70,8 +72,9 @@ PlanningSession::PlanningSession(const std::string& bundle_path, bool memory_map
       robot(load_bundle_robot(bundle.header(), robot_path)),
       settings(settings_from_header(bundle.header())),
       workspace(load_workspace_index(bundle, robot, memory_map)),
+      end_poses(bundle, robot),
       scenes(session_scenes(bundle.header(), robot, unsampled(settings.simulation), env_path,
-                            workspace)),
+                            workspace, end_poses)),
       indexes(load_bundle_indexes(bundle, memory_map)),
       index(indexes.starts),
       end_index(indexes.ends),
@@ -115,6 +118,7 @@ PlanningContext bundle_context(const Simulator& sim, const BundleView& bundle,
 PlanningContext PlanningSession::context(const PlanningWorld& w) const {
   PlanningContext c = bundle_context(w.sim, bundle, index, &end_index, mean_displacement);
   c.scene_marks = w.edge_marks.get();
+  c.end_poses = &end_poses;
   return c;
 }
 

@@ -60,6 +60,8 @@ class PlanningSession {
   // The edge-to-workspace index beside the bundle (workspace_index.h): each world other than
   // the bundle's own scene gets its edge marks from it when it is made.
   const WorkspaceIndexLoad workspace;
+  // Edge end poses per link, made at a pose goal's first use: goal coverage (end_pose_index.h).
+  const EndPoseIndexes end_poses;
   // The worlds planned in (world.h): the default, and scenes queries name (by content).
   mutable SceneCache scenes;
   const BundleIndexes indexes;     // where they come from: indexes.source

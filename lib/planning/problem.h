@@ -17,6 +17,10 @@
 #include "lazyboe/sim/simulator.h"
 
 namespace lazyboe {
+class EndPoseIndexes;
+}
+
+namespace lazyboe {
 
 struct Goal {
   enum class Kind { Joint, Position, Pose, Set };
@@ -61,10 +65,11 @@ struct Goal {
 bool needs_configurations(const Goal& goal);
 
 // Fills goal.configurations for a pose goal or a set (joint members: their q when valid), by
-// inverse kinematics from `start` and from seeded random configurations of the robot's region
-// and joint limits; sets goal.resolved. Deterministic in `seed`.
+// inverse kinematics from `start`, from the end states of the bundle edges whose end poses are
+// nearest the goal (`coverage`, when given), and from seeded random configurations of the
+// robot's region and joint limits; sets goal.resolved. Deterministic in `seed`.
 void resolve_goal(const Simulator& sim, SimulatorWorkspace& ws, const JointVectorRef& start,
-                  uint64_t seed, Goal& goal);
+                  uint64_t seed, Goal& goal, const EndPoseIndexes* coverage = nullptr);
 
 // When a solve stops: its wall-clock budget has run out or, with stop_at_first, it has found a
 // solution. (RRT, OMPL's RRT and KPIECE always stop at their first solution.)

@@ -169,7 +169,7 @@ PlanResult plan(const PlanningContext& context, SimulatorWorkspace& ws, const st
   p->setup(context);
   if (needs_configurations(problem.goal) && !problem.goal.resolved) {
     PlanningProblem resolved = problem;
-    resolve_goal(context.sim, ws, resolved.start, resolved.seed, resolved.goal);
+    resolve_goal(context.sim, ws, resolved.start, resolved.seed, resolved.goal, context.end_poses);
     validate_problem(context.sim, ws, resolved);
     return p->solve(resolved, ws, pool);
   }

@@ -3,11 +3,13 @@
 namespace lazyboe {
 
 SceneCache::SceneCache(const RobotModel& robot, const SimulationOptions& options,
-                       WorldPtr default_world, EdgeMarker marker, size_t capacity)
+                       WorldPtr default_world, EdgeMarker marker,
+                       const EndPoseIndexes* goal_coverage, size_t capacity)
     : robot_(robot),
       options_(options),
       default_world_(std::move(default_world)),
       marker_(std::move(marker)),
+      goal_coverage_(goal_coverage),
       capacity_(capacity) {}
 
 WorldPtr SceneCache::load(const std::string& path) { return world(load_environment(path)); }

@@ -10,17 +10,22 @@
 #include <string>
 
 #include "lazyboe/common/json_fields.h"
+#include "lazyboe/planning/end_pose_index.h"
 #include "lazyboe/planning/world.h"
 
 namespace lazyboe {
 
 class SceneCache {
  public:
-  // `marker`: how each new world learns the edges it may block (world.h).
+  // `marker`: how each new world learns the edges it may block (world.h). `goal_coverage`: the
+  // session's end-pose indexes, which seed the inverse kinematics of pose goals in every world
+  // (read_query); null: none.
   SceneCache(const RobotModel& robot, const SimulationOptions& options, WorldPtr default_world,
-             EdgeMarker marker = {}, size_t capacity = 16);
+             EdgeMarker marker = {}, const EndPoseIndexes* goal_coverage = nullptr,
+             size_t capacity = 16);
 
   const WorldPtr& default_world() const { return default_world_; }
+  const EndPoseIndexes* goal_coverage() const { return goal_coverage_; }
   // The world of an environment file (errors name the file and field).
   WorldPtr load(const std::string& path);
   // The world of an environment object held in memory (a query's inline "scene").
@@ -39,6 +44,7 @@ class SceneCache {
   const SimulationOptions options_;
   const WorldPtr default_world_;
   const EdgeMarker marker_;
+  const EndPoseIndexes* const goal_coverage_;
   const size_t capacity_;
   std::mutex mutex_;
   std::list<WorldPtr> recent_;  // most recently used first

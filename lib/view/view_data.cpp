@@ -153,11 +153,10 @@ json goal_marks(const JsonField& goal, int dof) {
     if (w.size() != 4) pose.at("orientation").fail("expected 4 numbers [w, x, y, z]");
     const Eigen::Quaterniond quaternion(w[0], w[1], w[2], w[3]);
     if (!(quaternion.norm() > 1e-9)) pose.at("orientation").fail("must not be zero");
-    g["pose"] = pose_json(Pose{quaternion.normalized().toRotationMatrix(),
-                               pose.at("position").vec3()});
+    g["pose"] =
+        pose_json(Pose{quaternion.normalized().toRotationMatrix(), pose.at("position").vec3()});
     if (pose.has("link")) g["link"] = pose.at("link").string();
-    if (goal.has("position_tolerance"))
-      g["tolerance"] = goal.at("position_tolerance").positive();
+    if (goal.has("position_tolerance")) g["tolerance"] = goal.at("position_tolerance").positive();
   } else if (goal.has("link")) {
     g["link"] = goal.at("link").string();
   }

@@ -28,8 +28,8 @@ def _quaternion(rotation):
 
 class Pose:
     """A pose goal: a link's position (m) and orientation (quaternion [w, x, y, z]) in the base
-    frame, each within its tolerance (m, rad). free_axis: a unit vector of the link's frame
-    about which any rotation will do (e.g. [0, 0, 1]: any yaw of the gripper). link: default the
+    frame, each within its tolerance (m, rad). free_axis: a vector of the base frame about
+    which any rotation will do (e.g. [0, 0, 1]: any yaw about the vertical). link: default the
     robot's tip link."""
 
     def __init__(self, position, orientation=(1.0, 0.0, 0.0, 0.0), *, free_axis=None, link=None,
