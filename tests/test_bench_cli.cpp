@@ -287,12 +287,47 @@ TEST(BenchCli, InterruptKeepsFinishedRunsForResume) {
   EXPECT_FALSE(fs::exists(dir + "/runs.partial.csv"));
 }
 
+// A study of pose goals with a task: problems.jsonl holds the pose goals, summary.md the task,
+// and the task reaches every run (a speed limit no motion meets fails them all; the same study
+// without it succeeds).
+TEST(BenchCli, PoseGoalsAndATaskReachEveryRun) {
+  const std::string dir = fresh_dir("task");
+  const std::string study = "--problems 2 " + budget(5) +
+                            " --planners lazysp --goals pose --no-figures --quiet --payload "
+                            "'{\"mass\": 2.0, \"com\": [0, 0, 0.05]}' ";
+  const CommandResult r = bench(study + "--out " + quote(dir + "/carried"));
+  ASSERT_EQ(r.exit_code, 0) << describe(r);
+  for (const std::string& line : lines_of(read_file(dir + "/carried/problems.jsonl"))) {
+    const nlohmann::json q = nlohmann::json::parse(line);
+    ASSERT_TRUE(q["goal"].contains("pose")) << line;
+    EXPECT_EQ(q["goal"]["position_tolerance"].get<double>(), 0.01);
+  }
+  EXPECT_NE(read_file(dir + "/carried/summary.md").find("Task of every run: payload"),
+            std::string::npos);
+  const auto successes = [&](const std::string& out) {
+    int n = 0;
+    for (const std::string& row : lines_of(read_file(out + "/runs.csv")))
+      n += fields_of(row).size() > 4 && fields_of(row)[4] == "1";
+    return n;
+  };
+  EXPECT_EQ(successes(dir + "/carried"), 2) << read_file(dir + "/carried/runs.csv");
+  const CommandResult slow = bench(study + "--end-effector-limits '{\"max_linear_speed\": 1e-4}' " +
+                                   "--out " + quote(dir + "/slow"));
+  ASSERT_EQ(slow.exit_code, 0) << describe(slow);
+  EXPECT_EQ(successes(dir + "/slow"), 0);
+}
+
 TEST(BenchCli, BadInputIsOneLineError) {
   const std::string dir = fresh_dir("bad");
   expect_one_line_error(bench("--planners lazyboe,foo --out " + quote(dir)), {"--planners", "foo"});
   expect_one_line_error(bench("--planners rrt,rrt --out " + quote(dir)), {"--planners", "twice"});
   expect_one_line_error(bench("--budget 0 --out " + quote(dir)), {"--budget"});
   expect_one_line_error(bench("--out " + quote(dir) + " --resume"), {"study.json", "no study"});
+  expect_one_line_error(bench("--payload '{\"mass\": -1}' --out " + quote(dir)),
+                        {"--payload", "mass"});
+  expect_one_line_error(bench("--end-effector-limits '{\"max_tilt\": 0.2}' --out " + quote(dir)),
+                        {"--end-effector-limits", "axis"});
+  expect_one_line_error(bench("--goals poses --out " + quote(dir)), {"--goals"});
   write_bytes(dir + "/bad.jsonl", "{\"id\": \"a\", \"start\": [0, 0]}\n");
   expect_one_line_error(bench("--problems-file " + quote(dir + "/bad.jsonl") +
                               " --planners rrt --quiet --out " + quote(dir + "/out")),

@@ -13,9 +13,11 @@
 
 #include "lazyboe/bench/report.h"
 #include "lazyboe/common/atomic_file.h"
+#include "lazyboe/common/json_fields.h"
 #include "lazyboe/planning/ompl/ompl_planners.h"
 #include "lazyboe/planning/planning_session.h"
 #include "lazyboe/planning/registry.h"
+#include "lazyboe/robot/payload.h"
 #include "tool_main.h"
 
 namespace {
@@ -75,6 +77,7 @@ struct BenchOptions {
   bool resume = false, force = false, no_figures = false, no_mmap = false, quiet = false;
   bool raw = false, no_direct = false;
   int shortcut_attempts = ExecutionOptions{}.shortcut_attempts;
+  std::string goals = "joint", payload, end_effector_limits;  // the study's goals and task
 };
 
 // The parameters a resumed study must share with the interrupted one.
@@ -89,7 +92,10 @@ nlohmann::json study_parameters(const BenchOptions& o) {
           {"tolerance", o.tolerance},
           {"raw", o.raw},
           {"no_direct", o.no_direct},
-          {"shortcut_attempts", o.shortcut_attempts}};
+          {"shortcut_attempts", o.shortcut_attempts},
+          {"goals", o.goals},
+          {"payload", o.payload},
+          {"end_effector_limits", o.end_effector_limits}};
 }
 
 void add_options(CLI::App& app, BenchOptions& o) {
@@ -142,7 +148,40 @@ void add_options(CLI::App& app, BenchOptions& o) {
                  "only)")
       ->capture_default_str()
       ->check(whole_number(true));
+  app.add_option("--goals", o.goals,
+                 "Goals of drawn problems: joint (a region of --tolerance around the goal "
+                 "configuration) or pose (the tip's pose there, 1 cm and 0.05 rad)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"joint", "pose"}));
+  app.add_option("--payload", o.payload,
+                 "A payload carried in every run, as a query's \"payload\" (JSON text)");
+  app.add_option("--end-effector-limits", o.end_effector_limits,
+                 "End-effector limits of every run, as a query's \"end_effector_limits\" (JSON "
+                 "text, with its \"axis\" when max_tilt is given)");
   app.add_flag("--quiet", o.quiet, "No progress output");
+}
+
+// The task of every run (--payload, --end-effector-limits), read as a query's fields are. A
+// tilt limit needs its axis: the default (the link's axis vertical at the start) would differ
+// from problem to problem, and a study plans in one world.
+Task study_task(const BenchOptions& o, const RobotModel& robot) {
+  Task task;
+  if (!o.payload.empty()) {
+    const nlohmann::json doc = parse_json_text(o.payload, "--payload", false);
+    task.payload = payload_from_json(JsonField(doc, "--payload", ""), robot);
+  }
+  if (!o.end_effector_limits.empty()) {
+    const nlohmann::json doc =
+        parse_json_text(o.end_effector_limits, "--end-effector-limits", false);
+    const JsonField f(doc, "--end-effector-limits", "");
+    if (f.value().is_object() && f.has("max_tilt") && !f.has("axis"))
+      f.fail(
+          "give \"axis\" with \"max_tilt\" in a study (its default, the axis vertical at "
+          "the start, would differ between problems)");
+    RobotData data(robot);
+    task.end_effector = end_effector_limits_from_json(f, robot, robot.q_min, data);
+  }
+  return task;
 }
 
 // The files of a study in --out.
@@ -197,27 +236,32 @@ void check_same_study(const fs::path& study_path, const nlohmann::json& paramete
 // study writes them and its parameters to --out. `source` says where they came from.
 std::vector<BenchProblem> study_problems(const BenchOptions& o, const StudyPaths& paths,
                                          const PlanningSession& session,
+                                         const PlanningContext& context,
                                          const nlohmann::json& parameters, std::string& source) {
-  const PlanningContext defaults = session.context();
-  SimulatorWorkspace ws(session.sim());
+  const Simulator& sim = context.sim;
+  SimulatorWorkspace ws(sim);
   const QueryDefaults query_defaults;
   if (o.resume) {
     source = "resumed from " + paths.problems.string();
-    return read_problems(paths.problems.string(), session.sim(), ws, query_defaults);
+    return read_problems(paths.problems.string(), sim, ws, query_defaults, &session.end_poses);
   }
   if (o.force) {  // study.json first: its absence marks the directory as not resumable
     for (const fs::path& p : {paths.study, paths.runs, paths.partial, paths.summary}) fs::remove(p);
   }
   std::vector<BenchProblem> problems;
   if (!o.problems_file.empty()) {
-    problems = read_problems(o.problems_file, session.sim(), ws, query_defaults);
+    problems = read_problems(o.problems_file, sim, ws, query_defaults, &session.end_poses);
     source = "read from " + o.problems_file;
   } else {
-    const double radius = o.tolerance > 0 ? o.tolerance : defaults.theta;
-    problems = sample_problems(session.sim(), ws, defaults.sample_lower, defaults.sample_upper,
-                               o.problems, radius, o.seed);
-    source = "drawn with seed " + std::to_string(o.seed) +
-             " in the bundle's region, goal tolerance " + std::to_string(radius) + " rad";
+    const double radius = o.tolerance > 0 ? o.tolerance : context.theta;
+    ProblemGoals goals;
+    goals.pose = o.goals == "pose";
+    goals.coverage = &session.end_poses;
+    problems = sample_problems(sim, ws, context.sample_lower, context.sample_upper, o.problems,
+                               radius, o.seed, goals);
+    source = "drawn with seed " + std::to_string(o.seed) + " in the bundle's region, " +
+             (goals.pose ? "pose goals (the tip at the goal configuration, 1 cm and 0.05 rad)"
+                         : "goal tolerance " + std::to_string(radius) + " rad");
   }
   write_problems(paths.problems.string(), session.robot, problems);
   write_text(paths.study, parameters.dump(2) + "\n");
@@ -284,14 +328,18 @@ void write_results(const BenchOptions& o, const StudyPaths& paths, const StudyIn
 }
 
 StudyInfo study_info(const BenchOptions& o, const PlanningSession& session,
+                     const PlanningContext& context, const PlanningWorld& world,
                      const std::vector<BenchProblem>& problems, const std::string& problems_source,
                      const std::string& command_line) {
   StudyInfo info;
-  info.direct = direct_solutions(session.context(), problems);
+  info.direct = direct_solutions(context, problems);
+  if (!o.payload.empty()) info.task = "payload " + o.payload;
+  if (!o.end_effector_limits.empty())
+    info.task += (info.task.empty() ? "" : ", ") + ("end-effector limits " + o.end_effector_limits);
   info.bundle = o.bundle_path;
   info.edges = session.bundle.size();
   info.robot = session.robot.config_path;
-  info.environment = session.world().env.path;
+  info.environment = world.env.path;
   info.problems = static_cast<int>(problems.size());
   info.problems_source = problems_source;
   info.repeats = o.repeats;
@@ -311,13 +359,16 @@ int run(const BenchOptions& o, const std::string& command_line) {
 
   planner_specs(o.planners);  // names checked before the bundle is loaded
   const PlanningSession session(o.bundle_path, !o.no_mmap, o.robot_path, o.env_path);
+  // The study's world: the session's scene with the task of every run.
+  const WorldPtr world =
+      session.scenes.with_task(session.scenes.default_world(), study_task(o, session.robot));
   if (!o.quiet) {
     std::fprintf(stderr, "lazyboe-bench: %s: %zu edges loaded in %.3f s\n", o.bundle_path.c_str(),
                  session.bundle.size(), session.load_seconds);
   }
   std::vector<PlannerSpec> specs = planner_specs(o.planners);
   if (o.no_direct) search_only(specs);
-  const PlanningContext context = session.context();
+  const PlanningContext context = session.context(*world);
   check_planner_specs(context, specs);
   for (const PlannerSpec& s : specs) {
     if (!s.available)
@@ -329,7 +380,7 @@ int run(const BenchOptions& o, const std::string& command_line) {
   fs::create_directories(paths.dir);
   std::string problems_source;
   const std::vector<BenchProblem> problems =
-      study_problems(o, paths, session, parameters, problems_source);
+      study_problems(o, paths, session, context, parameters, problems_source);
   std::vector<std::string> problem_ids;
   for (const BenchProblem& p : problems) problem_ids.push_back(p.id);
 
@@ -365,7 +416,8 @@ int run(const BenchOptions& o, const std::string& command_line) {
                  runs.size(), paths.partial.c_str());
     return 130;
   }
-  const StudyInfo info = study_info(o, session, problems, problems_source, command_line);
+  const StudyInfo info =
+      study_info(o, session, context, *world, problems, problems_source, command_line);
   write_results(o, paths, info, specs, runs, problem_ids);
   return 0;
 }

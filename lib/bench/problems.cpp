@@ -22,6 +22,27 @@ JointVector valid_sample(const Simulator& sim, SimulatorWorkspace& ws, const Joi
   fail("problems", "no collision-free configuration found in the sampling region");
 }
 
+// A query line without a seed resolves its goal with seed 1; drawn problems do the same, so that
+// a study resumed from its problems.jsonl plans for the same configurations.
+constexpr uint64_t kGoalSeed = 1;
+
+// The tip's pose at q as a goal, its configurations resolved from `start`.
+Goal pose_goal_at(const Simulator& sim, SimulatorWorkspace& ws, const JointVector& start,
+                  const JointVector& q, const ProblemGoals& goals) {
+  const RobotModel& robot = sim.robot;
+  forward_kinematics(robot, ws.robot, q);
+  const Pose pose = link_pose(robot, ws.robot, robot.tip_link());
+  Goal g;
+  g.kind = Goal::Kind::Pose;
+  g.link = robot.tip_link();
+  g.position = pose.p;
+  g.orientation = Eigen::Quaterniond(pose.R);
+  g.tolerance = goals.position_tolerance;
+  g.orientation_tolerance = goals.orientation_tolerance;
+  resolve_goal(sim, ws, start, kGoalSeed, g, goals.coverage);
+  return g;
+}
+
 nlohmann::json vector_json(const JointVectorRef& q) {
   return std::vector<double>(q.data(), q.data() + q.size());
 }
@@ -60,7 +81,8 @@ nlohmann::json goal_json(const RobotModel& robot, const Goal& g) {
 
 std::vector<BenchProblem> sample_problems(const Simulator& sim, SimulatorWorkspace& ws,
                                           const JointVector& lower, const JointVector& upper,
-                                          int count, double tolerance, uint64_t seed) {
+                                          int count, double tolerance, uint64_t seed,
+                                          const ProblemGoals& goals) {
   std::vector<BenchProblem> problems;
   Random rng(seed, 0x9b0b1e75);  // a stream of its own: problems do not depend on planners
   for (int k = 0; k < count; ++k) {
@@ -72,13 +94,15 @@ std::vector<BenchProblem> sample_problems(const Simulator& sim, SimulatorWorkspa
     } while ((p.goal.q - p.start).norm() <= tolerance);
     p.goal.kind = Goal::Kind::Joint;
     p.goal.tolerance = tolerance;
+    if (goals.pose) p.goal = pose_goal_at(sim, ws, p.start, p.goal.q, goals);
     problems.push_back(std::move(p));
   }
   return problems;
 }
 
 std::vector<BenchProblem> read_problems(const std::string& path, const Simulator& sim,
-                                        SimulatorWorkspace& ws, const QueryDefaults& defaults) {
+                                        SimulatorWorkspace& ws, const QueryDefaults& defaults,
+                                        const EndPoseIndexes* coverage) {
   require_input_file(path, "problems");
   std::ifstream in(path);
   if (!in) fail(path, "cannot open file");
@@ -91,7 +115,10 @@ std::vector<BenchProblem> read_problems(const std::string& path, const Simulator
       for (const BenchProblem& other : problems) {
         if (other.id == q.id) fail("line " + std::to_string(line), "id: '" + q.id + "' repeated");
       }
-      problems.push_back({q.id, q.request.problem.start, q.request.problem.goal});
+      BenchProblem p{q.id, q.request.problem.start, q.request.problem.goal};
+      if (coverage && needs_configurations(p.goal))  // read_query had no coverage
+        resolve_goal(sim, ws, p.start, q.request.problem.seed, p.goal, coverage);
+      problems.push_back(std::move(p));
     } catch (const Error& e) {
       fail(path, e.what());
     }

@@ -16,17 +16,31 @@ struct BenchProblem {
   Goal goal;
 };
 
+// How drawn problems give their goals: a joint-space region around the goal configuration, or
+// the pose of the tip there (docs/task.md), its configurations found with `coverage`.
+struct ProblemGoals {
+  bool pose = false;
+  double position_tolerance = 0.01, orientation_tolerance = 0.05;  // m, rad
+  const EndPoseIndexes* coverage = nullptr;
+};
+
 // `count` problems with start and goal uniform in [lower, upper], both valid (within the joint
 // limits, free of self- and environment collision) and farther apart than `tolerance` (a
-// joint-space goal region of that radius). Deterministic for a seed.
+// joint-space goal region of that radius; with goals.pose, the tip pose at the goal
+// configuration instead). The same seed draws the same configurations whatever the goals.
 std::vector<BenchProblem> sample_problems(const Simulator& sim, SimulatorWorkspace& ws,
                                           const JointVector& lower, const JointVector& upper,
-                                          int count, double tolerance, uint64_t seed);
+                                          int count, double tolerance, uint64_t seed,
+                                          const ProblemGoals& goals = {});
 
-// Problems from a JSON Lines file in the query format (schemas/query.schema.json); planner,
-// budget and seed fields are ignored. Throws Error naming the file and line of a bad query.
+// Problems from a JSON Lines file in the query format (schemas/query.schema.json); planner and
+// budget fields are ignored (a seed only seeds a pose goal's inverse kinematics), and a scene or
+// a task is refused (a study plans in one world: lazyboe-bench --env, --payload,
+// --end-effector-limits). Pose goals are resolved with `coverage`, as drawn ones are. Throws
+// Error naming the file and line of a bad query.
 std::vector<BenchProblem> read_problems(const std::string& path, const Simulator& sim,
-                                        SimulatorWorkspace& ws, const QueryDefaults& defaults);
+                                        SimulatorWorkspace& ws, const QueryDefaults& defaults,
+                                        const EndPoseIndexes* coverage = nullptr);
 
 // Writes problems in the query format (temporary file and rename).
 void write_problems(const std::string& path, const RobotModel& robot,

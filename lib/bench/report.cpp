@@ -376,6 +376,7 @@ std::string summary_markdown(const StudyInfo& info, const std::vector<PlannerSpe
   md << "- Problems: " << info.problems << " (" << info.problems_source << "), repeats "
      << info.repeats << ", budget " << fixed(info.budget, 1) << " s per run, study seed "
      << info.seed << ", " << info.jobs << " run(s) in parallel\n";
+  if (!info.task.empty()) md << "- Task of every run: " << info.task << "\n";
   if (info.direct >= 0)
     md << "- A single straight command (start to goal, rest to rest, within the bundle's command "
           "limits, every check) solves "

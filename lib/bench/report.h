@@ -44,6 +44,7 @@ void write_runs_csv(const std::string& path, const std::vector<RunRecord>& runs,
 
 struct StudyInfo {
   std::string bundle, robot, environment, command_line, machine, problems_source;
+  std::string task;  // every run's task as given (payload, end-effector limits); "": none
   size_t edges = 0;
   int problems = 0, repeats = 0, jobs = 0;
   double budget = 0;
