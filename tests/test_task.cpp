@@ -22,6 +22,7 @@
 #include "lazyboe/common/error.h"
 #include "lazyboe/common/json_fields.h"
 #include "lazyboe/io/query_io.h"
+#include "lazyboe/planning/edge_link_motion.h"
 #include "lazyboe/planning/end_pose_index.h"
 #include "lazyboe/planning/planning_session.h"
 #include "lazyboe/planning/request.h"
@@ -114,12 +115,21 @@ TEST(Payload, APointMassAndABoxAreTheirInertias) {
 }
 
 // A world of the fixture's scene carrying `task`, and its planning context.
+// A world with the task, and its context with what a session derives from the bundle for tasks
+// (goal coverage, the edges' link motions), as PlanningSession::context gives it.
 struct TaskWorld {
   TaskWorld(const Fixture& f, const Task& task)
       : world(f.robot, f.env, f.sim.options, {}, task),
-        context(bundle_context(world.sim, f.view, f.index)) {}
+        context(bundle_context(world.sim, f.view, f.index)),
+        end_poses(f.view, f.robot),
+        link_motions(f.view, f.robot) {
+    context.end_poses = &end_poses;
+    context.link_motions = &link_motions;
+  }
   PlanningWorld world;
   PlanningContext context;
+  EndPoseIndexes end_poses;
+  EdgeLinkMotions link_motions;
 };
 
 // Random commands of the bundle's family from random states of the robot's default region: 3 kg
@@ -301,6 +311,47 @@ TEST(EndEffectorLimits, EverySampleOfAReturnedTrajectoryKeepsThem) {
     ASSERT_TRUE(free.result.success);
     EXPECT_NE(end_effector_violations(f.robot, free.trajectory, task.end_effector), "");
   }
+}
+
+// The edges' link-motion figures (lazysp leaves out the edges whose figures break a limit) are
+// lower bounds of the peaks of the motion simulated at the control rate: an edge left out
+// breaks the limit for certain when applied from its own start.
+TEST(EndEffectorLimits, AnEdgesStoredMotionFiguresAreLowerBoundsOfItsPeaks) {
+  const Fixture& f = fixture();
+  const EdgeLinkMotion motion(f.view, f.robot, f.robot.tip_link());
+  SimulatorWorkspace ws(f.sim);
+  RobotData d(f.robot);
+  std::vector<double> ticks;
+  const int n = f.robot.dof;
+  const double dt = 1 / f.robot.control_rate;
+  double fastest = 0;
+  for (size_t e = 0; e < f.view.size(); e += f.view.size() / 40) {
+    ticks.clear();
+    TrajectorySamples samples;
+    samples.ticks = &ticks;
+    const RolloutResult r = simulate(f.sim, ws, Eigen::Map<const JointVector>(f.view.q0(e), n),
+                                     f.view.command(e), samples);
+    ASSERT_TRUE(r.valid()) << e;
+    double speed = 0, acceleration = 0;
+    Eigen::Vector3d p_prev = tip_position(f.robot, d, f.robot.tip_link(), f.edge_start(e));
+    Eigen::Vector3d v_prev = Eigen::Vector3d::Zero();
+    for (size_t k = 1; k < ticks.size() / (4 * n); ++k) {  // positions every tick
+      const JointVector q = Eigen::Map<const JointVector>(&ticks[4 * n * k], n);
+      const Eigen::Vector3d p = tip_position(f.robot, d, f.robot.tip_link(), q);
+      const Eigen::Vector3d v = (p - p_prev) / dt;
+      speed = std::max(speed, v.norm());
+      acceleration = std::max(acceleration, (v - v_prev).norm() / dt);
+      p_prev = p;
+      v_prev = v;
+    }
+    acceleration = std::max(acceleration, v_prev.norm() / dt);
+    // Stored samples are floats: 1e-6 rad of position is about 1e-4 m/s over 50 ms.
+    EXPECT_LE(motion[e].max_speed, speed + 1e-3) << e;
+    EXPECT_LE(motion[e].max_acceleration, acceleration + 1e-2) << e;
+    EXPECT_GT(motion[e].max_speed, 0.2 * speed) << e;  // and not vacuous
+    fastest = std::max(fastest, speed);
+  }
+  EXPECT_GT(fastest, 0.1);
 }
 
 TEST(EndEffectorLimits, ALimitNoMotionMeetsIsAClearFailure) {

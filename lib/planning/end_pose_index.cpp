@@ -74,11 +74,4 @@ void EndPoseIndex::nearest(const PoseTarget& target, size_t count,
   for (size_t i = 0; i < std::min(count, ranked.size()); ++i) out.push_back(ranked[i].second);
 }
 
-const EndPoseIndex& EndPoseIndexes::of(int link) const {
-  std::lock_guard<std::mutex> lock(mutex_);
-  std::unique_ptr<EndPoseIndex>& made = made_[link];
-  if (!made) made = std::make_unique<EndPoseIndex>(bundle_, robot_, link);
-  return *made;
-}
-
 }  // namespace lazyboe

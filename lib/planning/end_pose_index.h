@@ -5,12 +5,11 @@
 #pragma once
 
 #include <cstdint>
-#include <map>
 #include <memory>
-#include <mutex>
 #include <vector>
 
 #include "lazyboe/bundle/bundle_view.h"
+#include "lazyboe/planning/per_link.h"
 #include "lazyboe/robot/inverse_kinematics.h"
 
 namespace lazyboe {
@@ -46,18 +45,9 @@ class EndPoseIndex {
 };
 
 // The end-pose indexes of a bundle, one per link a pose goal names, each built on first use.
-// Thread-safe; an index once made stays (and its reference valid) as long as this.
-class EndPoseIndexes {
+class EndPoseIndexes : public PerLink<EndPoseIndex> {
  public:
-  EndPoseIndexes(const BundleView& bundle, const RobotModel& robot)
-      : bundle_(bundle), robot_(robot) {}
-  const EndPoseIndex& of(int link) const;
-
- private:
-  const BundleView& bundle_;
-  const RobotModel& robot_;
-  mutable std::mutex mutex_;
-  mutable std::map<int, std::unique_ptr<EndPoseIndex>> made_;
+  using PerLink::PerLink;
 };
 
 }  // namespace lazyboe

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "lazyboe/bundle/bundle_view.h"
+#include "lazyboe/planning/edge_link_motion.h"
 #include "lazyboe/planning/end_pose_index.h"
 #include "lazyboe/planning/neighbour_index.h"
 #include "lazyboe/planning/problem.h"
@@ -39,6 +40,8 @@ struct PlanningContext {
   const EdgeMarks* scene_marks = nullptr;
   // The bundle's edge end poses (pose goals' coverage: resolve_goal's seeds); null: none.
   const EndPoseIndexes* end_poses = nullptr;
+  // How the edges' stored motions move a link (a task's end-effector limits); null: none.
+  const EdgeLinkMotions* link_motions = nullptr;
 };
 
 // The prior probability that bundle edge `e` collides in the context's world: 1 for an edge an

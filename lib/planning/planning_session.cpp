@@ -73,6 +73,7 @@ PlanningSession::PlanningSession(const std::string& bundle_path, bool memory_map
       settings(settings_from_header(bundle.header())),
       workspace(load_workspace_index(bundle, robot, memory_map)),
       end_poses(bundle, robot),
+      link_motions(bundle, robot),
       scenes(session_scenes(bundle.header(), robot, unsampled(settings.simulation), env_path,
                             workspace, end_poses)),
       indexes(load_bundle_indexes(bundle, memory_map)),
@@ -119,6 +120,7 @@ PlanningContext PlanningSession::context(const PlanningWorld& w) const {
   PlanningContext c = bundle_context(w.sim, bundle, index, &end_index, mean_displacement);
   c.scene_marks = w.edge_marks.get();
   c.end_poses = &end_poses;
+  c.link_motions = &link_motions;
   return c;
 }
 

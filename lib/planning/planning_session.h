@@ -62,6 +62,9 @@ class PlanningSession {
   const WorkspaceIndexLoad workspace;
   // Edge end poses per link, made at a pose goal's first use: goal coverage (end_pose_index.h).
   const EndPoseIndexes end_poses;
+  // Per edge, how fast its stored motion moves a link, made at a task's first use (lazysp's
+  // end-effector limits, edge_link_motion.h).
+  const EdgeLinkMotions link_motions;
   // The worlds planned in (world.h): the default, and scenes queries name (by content).
   mutable SceneCache scenes;
   const BundleIndexes indexes;     // where they come from: indexes.source

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <functional>
 #include <optional>
@@ -75,6 +76,14 @@ class SearchState {
     return problem_.goal.distance(ctx_.sim.robot, goal_data_, q);
   }
   bool in_goal(double h) const { return h <= problem_.goal.tolerance; }
+  // Whether q keeps the task's tilt limit (end_effector_limits.max_tilt; true without one): a
+  // predicted state beyond it is a place the task may not go.
+  bool within_tilt(const JointVectorRef& q) {
+    const EndEffectorLimits& e = ctx_.sim.end_effector;
+    if (!e.any() || !std::isfinite(e.max_tilt)) return true;
+    forward_kinematics(ctx_.sim.robot, goal_data_, q);
+    return end_effector_tilt(ctx_.sim.robot, goal_data_, e) <= e.max_tilt;
+  }
 
   int add(Node n) {
     nodes_.push_back(std::move(n));

@@ -71,11 +71,14 @@ class LazySpSearch {
         h_scale_(ctx_.mean_displacement > 0 ? 1 + set_.edge_penalty / ctx_.mean_displacement : 1),
         rng_(solve.problem.seed, kStream),
         aims_at_configurations_(solve.problem.goal.kind != Goal::Kind::Joint &&
-                                !solve.problem.goal.configurations.empty()) {}
+                                !solve.problem.goal.configurations.empty()),
+        motions_(task_motions(ctx_)) {}
 
-  // Beyond a bundle, the growth needs a sampling box.
+  // Beyond a bundle, the growth needs a sampling box. A world with end-effector speed or
+  // acceleration limits gets its link's motion table here, in setup, before the solve's clock.
   static void check_context(const PlanningContext& ctx, const ParameterValues&) {
     check_sampling_box(ctx, "lazysp");
+    task_motions(ctx);
   }
 
   PlanResult run();
@@ -109,6 +112,17 @@ class LazySpSearch {
     return aims_at_configurations_ ? h <= set_.theta : s_.in_goal(h);
   }
   bool within_limits(const JointVector& q) const;
+  // The edges' stored link motions when the world limits the link's speed or acceleration
+  // (edge_link_motion.h); null otherwise.
+  static const EdgeLinkMotion* task_motions(const PlanningContext& ctx);
+  // Whether edge e's stored motion already breaks the task's speed or acceleration limit (its
+  // figures are lower bounds of the motion's peaks): the lazy search leaves it out.
+  bool breaks_task(uint32_t e) const {
+    if (!motions_) return false;
+    const EndEffectorLimits& l = ctx_.sim.end_effector;
+    const LinkMotion& m = (*motions_)[e];
+    return m.max_speed > l.max_linear_speed || m.max_acceleration > l.max_linear_acceleration;
+  }
   uint64_t cell(const JointVector& q) const;
   // The bundle's P_collision (its build scene's), and in a marked search the scene's marks.
   double risk(uint32_t e) const {
@@ -136,7 +150,8 @@ class LazySpSearch {
   // The heuristic counts the edge penalty too: h / mean displacement more edges to the goal.
   const double h_scale_;
   Random rng_;
-  const bool aims_at_configurations_;  // lazy_h
+  const bool aims_at_configurations_;    // lazy_h
+  const EdgeLinkMotion* const motions_;  // breaks_task
   bool goal_covered_ = true;
   std::unordered_set<uint64_t> tried_;  // (real node, edge) pairs simulated, valid or not
   std::vector<PathStep> commands_;      // the growth's commands, by LazySpNode::command
@@ -273,7 +288,7 @@ int LazySpSearch::expand(int p) {
     step_ = Eigen::Map<const Eigen::VectorXd>(bundle_.qf(e), n) -
             Eigen::Map<const Eigen::VectorXd>(bundle_.q0(e), n);
     next_ = from_ + step_;
-    if (!within_limits(next_)) continue;
+    if (breaks_task(e) || !within_limits(next_) || !s_.within_tilt(next_)) continue;
     Predicted c;
     const double displacement = step_.norm();  // a lower bound of the edge's arc length
     c.g = g + displacement + risk(e) + set_.edge_penalty;
@@ -423,6 +438,14 @@ bool LazySpSearch::prunable(double g, double h) {
   const PlanResult& r = s_.result();
   if (!r.success || s_.problem().goal.kind != Goal::Kind::Joint) return false;
   return g + std::max(0.0, h - s_.problem().goal.tolerance) >= r.best_cost;
+}
+
+const EdgeLinkMotion* LazySpSearch::task_motions(const PlanningContext& ctx) {
+  const EndEffectorLimits& l = ctx.sim.end_effector;
+  if (!ctx.link_motions || !l.any()) return nullptr;
+  if (!std::isfinite(l.max_linear_speed) && !std::isfinite(l.max_linear_acceleration))
+    return nullptr;
+  return &ctx.link_motions->of(l.link);
 }
 
 bool LazySpSearch::within_limits(const JointVector& q) const {
