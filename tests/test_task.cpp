@@ -112,9 +112,12 @@ TEST(Payload, APointMassAndABoxAreTheirInertias) {
   EXPECT_NEAR(box.inertia(0, 0), 13.0, 1e-12);  // m (b^2 + c^2) / 12
   EXPECT_NEAR(box.inertia(1, 1), 10.0, 1e-12);
   EXPECT_NEAR(box.inertia(2, 2), 5.0, 1e-12);
+  // A box of water: its density instead of its mass.
+  const Payload water = payload_of(panda, {{"density", 1000.0}, {"box", {0.1, 0.2, 0.3}}});
+  EXPECT_NEAR(water.mass, 6.0, 1e-12);
+  EXPECT_NEAR(water.inertia(2, 2), 6.0 * (0.01 + 0.04) / 12, 1e-12);
 }
 
-// A world of the fixture's scene carrying `task`, and its planning context.
 // A world with the task, and its context with what a session derives from the bundle for tasks
 // (goal coverage, the edges' link motions), as PlanningSession::context gives it.
 struct TaskWorld {
@@ -634,6 +637,9 @@ TEST(TaskInput, BadFieldsAreOneLineNamingTheField) {
       {{{"payload", {{"mass", 1}, {"link", "panda_link0"}}}},
        "line 1: payload.link: 'panda_link0' does not move"},
       {{{"payload", {{"mas", 1}}}}, "line 1: payload.mas: unknown field (did you mean 'mass'?)"},
+      {{{"payload", {{"density", 1000}}}}, "line 1: payload.density: needs \"box\""},
+      {{{"payload", {{"density", 1000}, {"mass", 1}, {"box", {0.1, 0.1, 0.1}}}}},
+       "line 1: payload: give \"mass\" or \"density\", not both"},
       {{{"end_effector_limits", {{"max_tilt", -0.1}}}},
        "line 1: end_effector_limits.max_tilt: -0.1 is outside"},
       {{{"end_effector_limits", {{"axis", {0, 0, 0}}}}},

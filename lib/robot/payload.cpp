@@ -35,23 +35,31 @@ Eigen::Matrix3d inertia_from_json(const JsonField& f) {
   return I;
 }
 
+// "mass" (kg), or "density" (kg/m^3) of the solid "box".
+double payload_mass(const JsonField& f, const Eigen::Vector3d& box) {
+  if (!f.has("density")) return f.at("mass").number_in({0, 1e4}, " kg");
+  if (f.has("mass")) f.fail("give \"mass\" or \"density\", not both");
+  if (!f.has("box")) f.at("density").fail("needs \"box\", the solid it is the density of");
+  const double mass = f.at("density").number_in({0, 1e5}, " kg/m^3") * box.prod();
+  if (mass > 1e4) f.at("density").fail("gives a mass above 10000 kg");
+  return mass;
+}
+
 }  // namespace
 
 Payload payload_from_json(const JsonField& f, const RobotModel& robot) {
   if (!f.value().is_object()) f.fail("expected an object with \"mass\" (kg)");
-  f.allow_only({"mass", "com", "inertia", "box", "link"});
+  f.allow_only({"mass", "density", "com", "inertia", "box", "link"});
   Payload p;
   p.link = link_field(f, robot);
   if (robot.links[p.link].body < 0)
     f.at("link").fail("'" + robot.links[p.link].name + "' does not move");
-  p.mass = f.at("mass").number_in({0, 1e4}, " kg");
-  if (f.has("com")) p.com = f.at("com").vec3_in({-10, 10}, " m");
   if (f.has("inertia") && f.has("box")) f.fail("give \"inertia\" or \"box\", not both");
+  if (f.has("box")) p.box = f.at("box").vec3_in({0, 10}, " m");
+  p.mass = payload_mass(f, p.box);
+  if (f.has("com")) p.com = f.at("com").vec3_in({-10, 10}, " m");
   if (f.has("inertia")) p.inertia = inertia_from_json(f.at("inertia"));
-  if (f.has("box")) {
-    p.box = f.at("box").vec3_in({0, 10}, " m");
-    p.inertia = box_inertia(p.mass, p.box);
-  }
+  if (f.has("box")) p.inertia = box_inertia(p.mass, p.box);
   return p;
 }
 

@@ -25,9 +25,9 @@ struct Payload {
 Eigen::Matrix3d box_inertia(double mass, const Eigen::Vector3d& size);
 
 // Reads {"mass": kg, "com": [x, y, z], "inertia": [ixx, ixy, ixz, iyy, iyz, izz] (URDF's
-// order; default: a point mass) or "box": [sx, sy, sz] (a solid box), "link": name (default:
-// the tip link)}. Throws Error naming the field for a negative mass, an inertia that is not
-// positive semi-definite, an unknown link or the base.
+// order; default: a point mass) or "box": [sx, sy, sz] (a solid box; with it "density", kg/m^3,
+// may replace "mass"), "link": name (default: the tip link)}. Throws Error naming the field for
+// a negative mass, an inertia that is not positive semi-definite, an unknown link or the base.
 Payload payload_from_json(const JsonField& field, const RobotModel& robot);
 
 // `robot` carrying `payload` (merged into the moving body of its link).
