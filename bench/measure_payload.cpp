@@ -57,6 +57,8 @@ Args parse(int argc, char** argv) {
     }
   }
   if (a.bundle.empty()) fail("usage", "measure_payload BUNDLE [--edges N] [--masses 0,1,2,3]");
+  if (a.edges < 1) fail("--edges", "must be a whole number >= 1");
+  if (a.perturbations < 1) fail("--perturbations", "must be a whole number >= 1");
   return a;
 }
 
@@ -133,11 +135,11 @@ void measure_mass(const PlanningSession& session, const std::vector<size_t>& edg
     for (const double x : v) sum += x;
     return v.empty() ? 0.0 : sum / static_cast<double>(v.size());
   };
-  std::printf(
-      "| %.1f kg | %.1f%% | %.4f / %.4f | %.1f%% | %.3f | %.4f / %.4f / %.4f | %.3f |\n", mass,
-      100.0 * own_valid / edges.size(), quantile(own_error, 0.5), quantile(own_error, 0.9),
-      100.0 * valid / (edges.size() * a.perturbations), mean(p_lazy), quantile(transfer_max, 0.5),
-      quantile(transfer_max, 0.9), quantile(transfer_max, 1.0), mean(p_transfer));
+  std::printf("| %.1f kg | %.1f%% | %.4f / %.4f | %.1f%% | %.3f | %.4f / %.4f / %.4f | %.3f |\n",
+              mass, 100.0 * own_valid / edges.size(), quantile(own_error, 0.5),
+              quantile(own_error, 0.9), 100.0 * valid / (edges.size() * a.perturbations),
+              mean(p_lazy), quantile(transfer_max, 0.5), quantile(transfer_max, 0.9),
+              quantile(transfer_max, 1.0), mean(p_transfer));
 }
 
 }  // namespace

@@ -328,6 +328,9 @@ TEST(BenchCli, BadInputIsOneLineError) {
   expect_one_line_error(bench("--end-effector-limits '{\"max_tilt\": 0.2}' --out " + quote(dir)),
                         {"--end-effector-limits", "axis"});
   expect_one_line_error(bench("--goals poses --out " + quote(dir)), {"--goals"});
+  expect_one_line_error(bench("--goals pose --problems-file " + quote(dir + "/bad.jsonl") +
+                              " --out " + quote(dir)),
+                        {"--problems-file excludes --goals"});
   write_bytes(dir + "/bad.jsonl", "{\"id\": \"a\", \"start\": [0, 0]}\n");
   expect_one_line_error(bench("--problems-file " + quote(dir + "/bad.jsonl") +
                               " --planners rrt --quiet --out " + quote(dir + "/out")),

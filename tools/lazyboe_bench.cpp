@@ -106,9 +106,10 @@ void add_options(CLI::App& app, BenchOptions& o) {
   app.add_option("--problems", o.problems, "Random problems to draw in the bundle's region")
       ->capture_default_str()
       ->check(whole_number(false));
-  app.add_option("--problems-file", o.problems_file,
-                 "Read the problems from a JSON Lines query file instead (e.g. an earlier "
-                 "study's problems.jsonl)");
+  CLI::Option* problems_file =
+      app.add_option("--problems-file", o.problems_file,
+                     "Read the problems from a JSON Lines query file instead (e.g. an earlier "
+                     "study's problems.jsonl)");
   app.add_option("--budget", o.budget, "Wall-clock seconds per run")
       ->capture_default_str()
       ->check(real_in({0, kMaxBudgetSeconds, true}, " s"));
@@ -152,7 +153,8 @@ void add_options(CLI::App& app, BenchOptions& o) {
                  "Goals of drawn problems: joint (a region of --tolerance around the goal "
                  "configuration) or pose (the tip's pose there, 1 cm and 0.05 rad)")
       ->capture_default_str()
-      ->check(CLI::IsMember({"joint", "pose"}));
+      ->check(CLI::IsMember({"joint", "pose"}))
+      ->excludes(problems_file);
   app.add_option("--payload", o.payload,
                  "A payload carried in every run, as a query's \"payload\" (JSON text)");
   app.add_option("--end-effector-limits", o.end_effector_limits,

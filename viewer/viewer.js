@@ -380,7 +380,10 @@
   function showGoal(goal) {
     for (const o of goalMarks.children.slice()) {
       goalMarks.remove(o);
-      if (o instanceof THREE.AxesHelper) o.geometry.dispose();
+      if (o instanceof THREE.AxesHelper) {
+        o.geometry.dispose();
+        o.material.dispose();
+      }
     }
     goalGhosts.forEach((g) => { g.group.visible = false; });
     let ghosts = 0;

@@ -85,6 +85,7 @@ std::vector<BenchProblem> sample_problems(const Simulator& sim, SimulatorWorkspa
                                           const ProblemGoals& goals) {
   std::vector<BenchProblem> problems;
   Random rng(seed, 0x9b0b1e75);  // a stream of its own: problems do not depend on planners
+  int redrawn = 0;
   for (int k = 0; k < count; ++k) {
     BenchProblem p;
     p.id = "p" + std::to_string(k);
@@ -94,7 +95,17 @@ std::vector<BenchProblem> sample_problems(const Simulator& sim, SimulatorWorkspa
     } while ((p.goal.q - p.start).norm() <= tolerance);
     p.goal.kind = Goal::Kind::Joint;
     p.goal.tolerance = tolerance;
-    if (goals.pose) p.goal = pose_goal_at(sim, ws, p.start, p.goal.q, goals);
+    if (goals.pose) {
+      p.goal = pose_goal_at(sim, ws, p.start, p.goal.q, goals);
+      // A pose whose inverse kinematics finds no valid configuration would be refused as a
+      // query (and when the study is resumed from problems.jsonl): drawn again.
+      if (p.goal.configurations.empty()) {
+        if (++redrawn > 10 * count + 100)
+          fail("problems", "inverse kinematics found no valid configuration for the drawn poses");
+        --k;
+        continue;
+      }
+    }
     problems.push_back(std::move(p));
   }
   return problems;
@@ -111,14 +122,11 @@ std::vector<BenchProblem> read_problems(const std::string& path, const Simulator
   for (int line = 1; std::getline(in, text); ++line) {
     if (text.find_first_not_of(" \t\r") == std::string::npos) continue;
     try {
-      const Query q = parse_query(text, line, sim, ws, defaults, id);
+      const Query q = parse_query(text, line, sim, ws, defaults, id, nullptr, coverage);
       for (const BenchProblem& other : problems) {
         if (other.id == q.id) fail("line " + std::to_string(line), "id: '" + q.id + "' repeated");
       }
-      BenchProblem p{q.id, q.request.problem.start, q.request.problem.goal};
-      if (coverage && needs_configurations(p.goal))  // read_query had no coverage
-        resolve_goal(sim, ws, p.start, q.request.problem.seed, p.goal, coverage);
-      problems.push_back(std::move(p));
+      problems.push_back({q.id, q.request.problem.start, q.request.problem.goal});
     } catch (const Error& e) {
       fail(path, e.what());
     }

@@ -27,7 +27,8 @@ struct ProblemGoals {
 // `count` problems with start and goal uniform in [lower, upper], both valid (within the joint
 // limits, free of self- and environment collision) and farther apart than `tolerance` (a
 // joint-space goal region of that radius; with goals.pose, the tip pose at the goal
-// configuration instead). The same seed draws the same configurations whatever the goals.
+// configuration instead, drawn again when its inverse kinematics finds no valid configuration).
+// For a seed, pose goals are at the configurations of the joint goals, but for those redrawn.
 std::vector<BenchProblem> sample_problems(const Simulator& sim, SimulatorWorkspace& ws,
                                           const JointVector& lower, const JointVector& upper,
                                           int count, double tolerance, uint64_t seed,

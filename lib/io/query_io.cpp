@@ -217,7 +217,7 @@ WorldPtr parse_task(const JsonField& root, const Simulator& sim, SimulatorWorksp
 
 Query read_query(const nlohmann::json& doc, const std::string& where, const Simulator& sim,
                  SimulatorWorkspace& ws, const QueryDefaults& d, SceneCache* scenes,
-                 const WorldPtr& base) {
+                 const WorldPtr& base, const EndPoseIndexes* coverage) {
   if (!doc.is_object()) fail(where, "expected a JSON object");
   const JsonField root(doc, where, "");
   root.allow_only(query_fields());
@@ -231,19 +231,23 @@ Query read_query(const nlohmann::json& doc, const std::string& where, const Simu
   const Simulator& in = q.world ? q.world->sim : sim;
   PlanningProblem& p = q.request.problem;
   if (needs_configurations(p.goal))
-    resolve_goal(in, ws, p.start, p.seed, p.goal, scenes ? scenes->goal_coverage() : nullptr);
+    resolve_goal(in, ws, p.start, p.seed, p.goal,
+                 coverage ? coverage
+                 : scenes ? scenes->goal_coverage()
+                          : nullptr);
   const ProblemIssue issue = find_problem_issue(in, ws, q.request.problem);
   if (issue.any()) fail(where.empty() ? issue.field : where + ": " + issue.field, issue.what);
   return q;
 }
 
 Query parse_query(const std::string& text, int line, const Simulator& sim, SimulatorWorkspace& ws,
-                  const QueryDefaults& d, std::string& id_out, SceneCache* scenes) {
+                  const QueryDefaults& d, std::string& id_out, SceneCache* scenes,
+                  const EndPoseIndexes* coverage) {
   const std::string where = "line " + std::to_string(line);
   const nlohmann::json doc = parse_json_text(text, where, false);
   if (doc.is_object() && doc.contains("id") && doc["id"].is_string())
     id_out = doc["id"].get<std::string>();
-  Query q = read_query(doc, where, sim, ws, d, scenes);
+  Query q = read_query(doc, where, sim, ws, d, scenes, nullptr, coverage);
   q.line = line;
   return q;
 }

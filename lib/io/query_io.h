@@ -39,14 +39,18 @@ struct QueryDefaults {
 // `scenes` (null: naming one is an error), or else `sim`'s. A query may set only parameters its
 // planner declares. Throws Error("line N: field: what") for anything malformed, out of range,
 // out of limits or in collision.
+// `coverage`: the bundle's end poses for a pose goal's inverse kinematics when there are no
+// `scenes` (whose goal_coverage() serves otherwise).
 Query parse_query(const std::string& text, int line, const Simulator& sim, SimulatorWorkspace& ws,
-                  const QueryDefaults& defaults, std::string& id_out, SceneCache* scenes = nullptr);
+                  const QueryDefaults& defaults, std::string& id_out, SceneCache* scenes = nullptr,
+                  const EndPoseIndexes* coverage = nullptr);
 // The same for a query held as JSON; `where` starts its errors ("line 3", "queries[2]"; empty:
 // the field alone). `base`: the caller's world when it is not the session's default (`sim` is
 // its simulator): a query's task (payload, end-effector limits) is added to it.
 Query read_query(const nlohmann::json& doc, const std::string& where, const Simulator& sim,
                  SimulatorWorkspace& ws, const QueryDefaults& defaults,
-                 SceneCache* scenes = nullptr, const WorldPtr& base = nullptr);
+                 SceneCache* scenes = nullptr, const WorldPtr& base = nullptr,
+                 const EndPoseIndexes* coverage = nullptr);
 
 enum class TrajectoryOutput { None, Inline, Csv };
 

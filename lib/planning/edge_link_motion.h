@@ -2,9 +2,10 @@
 // largest linear speed and acceleration of the link's origin, by finite differences of its
 // positions at the stored samples (every sample_interval, from the edge's start at rest to its
 // end). Differences average over the sample spacing, so both are lower bounds of the motion's
-// peaks: an edge whose figures break a task's limit breaks it when simulated, and applied near
-// its start (displacement transfer), very likely too. lazysp leaves such edges out of its lazy
-// search (docs/task.md).
+// peaks (up to the float precision of the samples): an edge whose figures break a task's limit
+// breaks it when simulated from its own start, and applied near it (displacement transfer),
+// very likely too. lazysp leaves such edges out of its lazy search (docs/task.md), from every
+// state: the growth, which is not limited so, keeps the planner complete.
 #pragma once
 
 #include <vector>

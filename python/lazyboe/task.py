@@ -19,11 +19,24 @@ def _vector(value, size, name):
 def _quaternion(rotation):
     """[w, x, y, z] (w >= 0) of a 3x3 rotation matrix."""
     m = np.asarray(rotation, dtype=float)
-    w = np.sqrt(max(0.0, 1 + m[0, 0] + m[1, 1] + m[2, 2])) / 2
-    x = np.copysign(np.sqrt(max(0.0, 1 + m[0, 0] - m[1, 1] - m[2, 2])) / 2, m[2, 1] - m[1, 2])
-    y = np.copysign(np.sqrt(max(0.0, 1 - m[0, 0] + m[1, 1] - m[2, 2])) / 2, m[0, 2] - m[2, 0])
-    z = np.copysign(np.sqrt(max(0.0, 1 - m[0, 0] - m[1, 1] + m[2, 2])) / 2, m[1, 0] - m[0, 1])
-    return [float(w), float(x), float(y), float(z)]
+    trace = m[0, 0] + m[1, 1] + m[2, 2]
+    # Shepperd's method: from the largest of w, x, y, z, so that no division is by ~0.
+    k = int(np.argmax([trace, m[0, 0], m[1, 1], m[2, 2]]))
+    if k == 0:
+        s = 2 * np.sqrt(1 + trace)
+        q = [s / 4, (m[2, 1] - m[1, 2]) / s, (m[0, 2] - m[2, 0]) / s, (m[1, 0] - m[0, 1]) / s]
+    elif k == 1:
+        s = 2 * np.sqrt(1 + m[0, 0] - m[1, 1] - m[2, 2])
+        q = [(m[2, 1] - m[1, 2]) / s, s / 4, (m[0, 1] + m[1, 0]) / s, (m[0, 2] + m[2, 0]) / s]
+    elif k == 2:
+        s = 2 * np.sqrt(1 - m[0, 0] + m[1, 1] - m[2, 2])
+        q = [(m[0, 2] - m[2, 0]) / s, (m[0, 1] + m[1, 0]) / s, s / 4, (m[1, 2] + m[2, 1]) / s]
+    else:
+        s = 2 * np.sqrt(1 - m[0, 0] - m[1, 1] + m[2, 2])
+        q = [(m[1, 0] - m[0, 1]) / s, (m[0, 2] + m[2, 0]) / s, (m[1, 2] + m[2, 1]) / s, s / 4]
+    if q[0] < 0:
+        q = [-v for v in q]
+    return [float(v) for v in q]
 
 
 class Pose:
@@ -32,7 +45,7 @@ class Pose:
     which any rotation will do (e.g. [0, 0, 1]: any yaw about the vertical). link: default the
     robot's tip link."""
 
-    def __init__(self, position, orientation=(1.0, 0.0, 0.0, 0.0), *, free_axis=None, link=None,
+    def __init__(self, position, orientation, *, free_axis=None, link=None,
                  position_tolerance=0.01, orientation_tolerance=0.05):
         self.position = _vector(position, 3, "position")
         self.orientation = _vector(orientation, 4, "orientation")
@@ -67,10 +80,13 @@ class Pose:
 class Payload:
     """What the arm carries: mass (kg), centre of mass (m) in the link's frame, and either its
     inertia about the centre of mass ([ixx, ixy, ixz, iyy, iyz, izz], kg m^2, URDF order) or a
-    solid box's size (m); neither: a point mass. link: default the robot's tip link."""
+    solid box's size (m), whose density (kg/m^3) may replace the mass (mass=None); neither: a
+    point mass. link: default the robot's tip link."""
 
-    def __init__(self, mass, com=(0.0, 0.0, 0.0), *, inertia=None, box=None, link=None):
-        self.mass = float(mass)
+    def __init__(self, mass, com=(0.0, 0.0, 0.0), *, inertia=None, box=None, density=None,
+                 link=None):
+        self.mass = None if mass is None else float(mass)
+        self.density = None if density is None else float(density)
         self.com = _vector(com, 3, "com")
         self.inertia = None if inertia is None else _vector(inertia, 6, "inertia")
         self.box = None if box is None else _vector(box, 3, "box")
@@ -78,8 +94,8 @@ class Payload:
 
     def to_query(self):
         """The payload as the query format has it."""
-        q = {"mass": self.mass, "com": self.com}
-        for key in ("inertia", "box", "link"):
+        q = {"com": self.com}
+        for key in ("mass", "density", "inertia", "box", "link"):
             if getattr(self, key) is not None:
                 q[key] = getattr(self, key)
         return q

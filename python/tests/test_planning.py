@@ -183,17 +183,56 @@ def test_typed_task_objects_are_the_query_format(session):
     assert np.arccos(np.clip((end[:3, :3].T @ up) @ (pose[:3, :3].T @ up), -1, 1)) <= 0.05
     with pytest.raises(ValueError, match="orientation: expected 4 numbers"):
         lazyboe.Pose([0.5, 0, 0.5], [1, 0, 0])
+    water = lazyboe.Payload(None, box=[0.1, 0.1, 0.1], density=1000)
+    assert water.to_query() == {"com": [0.0, 0.0, 0.0], "density": 1000.0, "box": [0.1] * 3}
     with pytest.raises(ValueError, match="payload.mass"):
         session.plan(START, goal, payload=lazyboe.Payload(-1.0))
 
 
 def quaternion(m):
-    """[w, x, y, z] of a rotation matrix (w >= 0)."""
-    w = np.sqrt(max(0.0, 1 + m[0, 0] + m[1, 1] + m[2, 2])) / 2
-    x = np.copysign(np.sqrt(max(0.0, 1 + m[0, 0] - m[1, 1] - m[2, 2])) / 2, m[2, 1] - m[1, 2])
-    y = np.copysign(np.sqrt(max(0.0, 1 - m[0, 0] + m[1, 1] - m[2, 2])) / 2, m[0, 2] - m[2, 0])
-    z = np.copysign(np.sqrt(max(0.0, 1 - m[0, 0] - m[1, 1] + m[2, 2])) / 2, m[1, 0] - m[0, 1])
-    return [w, x, y, z]
+    """[w, x, y, z] of a rotation matrix (w >= 0), from the axis and angle (independent of
+    lazyboe.Pose's conversion)."""
+    angle = np.arccos(np.clip((np.trace(m) - 1) / 2, -1, 1))
+    if angle < 1e-9:
+        return [1.0, 0.0, 0.0, 0.0]
+    if np.pi - angle < 1e-6:  # a half turn: the axis from the symmetric part
+        axis = np.sqrt(np.clip((np.diag(m) + 1) / 2, 0, None))
+        i = int(np.argmax(axis))
+        axis = np.array([(m[i, j] + m[j, i]) / 2 for j in range(3)]) / axis[i]
+        axis[i] = np.sqrt((m[i, i] + 1) / 2)
+    else:
+        axis = np.array([m[2, 1] - m[1, 2], m[0, 2] - m[2, 0], m[1, 0] - m[0, 1]])
+    axis = axis / np.linalg.norm(axis)
+    q = [np.cos(angle / 2), *(np.sin(angle / 2) * axis)]
+    return [float(v) for v in (q if q[0] >= 0 else -np.array(q))]
+
+
+def rotation_of(q):
+    """The rotation matrix of a unit quaternion [w, x, y, z]."""
+    w, x, y, z = q
+    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+                     [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+                     [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
+
+
+def test_pose_from_a_matrix_keeps_every_rotation():
+    """Pose.from_matrix gives the quaternion of the rotation, half turns included (a gripper
+    pointing down is one: its diagonal terms decide the axis)."""
+    rng = np.random.default_rng(4)
+    down = np.diag([1.0, -1.0, -1.0])
+    cases = [np.eye(3), down, np.diag([-1.0, 1.0, -1.0]), np.diag([-1.0, -1.0, 1.0])]
+    for yaw in (-np.pi / 4, np.pi / 3, np.pi - 1e-9):
+        c, s = np.cos(yaw), np.sin(yaw)
+        cases.append(np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]]) @ down)
+    for _ in range(20):
+        q = rng.normal(size=4)
+        cases.append(rotation_of(q / np.linalg.norm(q)))
+    for m in cases:
+        t = np.eye(4)
+        t[:3, :3] = m
+        w = lazyboe.Pose.from_matrix(t).orientation
+        assert np.abs(rotation_of(w) - m).max() < 1e-9, (m, w)
+        assert w[0] >= 0
 
 
 def test_no_solution_is_a_result(session):
