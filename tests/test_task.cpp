@@ -574,6 +574,34 @@ TEST(PoseGoal, ConfigurationsFromTheEndPoseIndexLieInTheBundlesCoverage) {
   EXPECT_LE(covered[0], 6);
 }
 
+// A start already inside the goal region is answered (issue 30), not refused: whatever the
+// planner, raw or executable, the trajectory of that one state at rest, found_by "start".
+TEST(StartInGoal, IsATrivialSuccessOfOneState) {
+  const Fixture& f = fixture();
+  SimulatorWorkspace ws(f.sim);
+  const PlanningContext context = bundle_context(f.sim, f.view, f.index);
+  JointVector near = f.a;
+  near[0] += 0.5 * kTolerance;
+  for (const std::string planner : {"lazysp", "lazyboe", "rrt", "sst"}) {
+    for (const bool raw : {false, true}) {
+      PlanRequest r = request(planner, f.a, near);
+      r.output.raw = raw;
+      const PlanAnswer a = answer_request(context, r, ws);
+      ASSERT_TRUE(a.result.success) << planner << ": " << a.result.failure;
+      EXPECT_EQ(a.result.found_by, "start") << planner;
+      EXPECT_EQ(a.result.counters.simulations, 0u) << planner;
+      ASSERT_EQ(a.trajectory.t.size(), 1u) << planner;
+      EXPECT_EQ(a.trajectory.q[0], f.a) << planner;
+      EXPECT_TRUE(a.trajectory.dq[0].isZero()) << planner;
+      EXPECT_EQ(a.trajectory.ddq.size(), raw ? 0u : 1u) << planner;
+    }
+  }
+  // A pose goal at the start's own tip pose too.
+  PlanRequest r = request("lazysp", f.a, f.a);
+  r.problem.goal = pose_goal(f.robot, f.a);
+  EXPECT_EQ(answer_request(context, r, ws).result.found_by, "start");
+}
+
 // A study's problems file keeps pose goals and goal sets as they were read (lazyboe-bench
 // --problems-file repeats a study from it).
 TEST(PoseGoal, AStudysProblemsFileKeepsPoseGoalsAndSets) {

@@ -144,12 +144,24 @@ RolloutResult simulate_to_target(Work& w, const JointVectorRef& q0, std::vector<
   }
 }
 
+// One state at rest: the answer when the start was in the goal (an executable trajectory has
+// its zero acceleration and command too).
+Trajectory at_rest(const JointVector& q, bool executable) {
+  Trajectory t;
+  t.t = {0.0};
+  t.q = {q};
+  t.dq = {JointVector::Zero(q.size())};
+  if (executable) t.ddq = t.cmd = t.dq;
+  return t;
+}
+
 }  // namespace
 
 Trajectory returned_trajectory(const Simulator& sim, SimulatorWorkspace& ws,
                                const PlanningProblem& problem, const std::vector<PathStep>& path,
                                bool raw, const ExecutionOptions& options, int sample_every,
                                ExecutionStats& stats) {
+  if (path.empty()) return at_rest(problem.start, !raw);  // the start was in the goal
   if (raw) return realize_path(sim, ws, problem.start, path, problem.goal, sample_every);
   ExecutableTrajectory e =
       make_executable(sim, ws, problem.start, path, problem.goal, options, sample_every);

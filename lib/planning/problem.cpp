@@ -183,8 +183,6 @@ ProblemIssue find_problem_issue(const Simulator& sim, SimulatorWorkspace& ws,
                                 const PlanningProblem& p) {
   if (ProblemIssue i = state_issue(sim, ws, "start", p.start); i.any()) return i;
   if (ProblemIssue i = goal_issue(sim, ws, "goal", p.goal); i.any()) return i;
-  if (p.goal.contains(sim.robot, ws.robot, p.start))
-    return {"goal", "the start already satisfies the goal"};
   if (!(p.termination.budget > 0 && p.termination.budget <= kMaxBudgetSeconds))
     return {"budget", "must be in (0, 1000000] s"};
   return {};

@@ -145,6 +145,18 @@ const char* type_name(ParameterType t) {
   }
 }
 
+// A start already inside the goal region is answered, not refused (issue 30): the path of no
+// motion, whatever the planner.
+PlanResult start_in_goal() {
+  PlanResult r;
+  r.success = true;
+  r.time_to_first_solution = 0;
+  r.n_solutions = 1;
+  r.best_cost = 0;
+  r.found_by = "start";
+  return r;
+}
+
 }  // namespace
 
 std::string planner_list_text() {
@@ -167,14 +179,16 @@ PlanResult plan(const PlanningContext& context, SimulatorWorkspace& ws, const st
                 const ParameterValues& values, const PlanningProblem& problem, RolloutPool* pool) {
   const std::unique_ptr<Planner> p = make_planner(planner, values);
   p->setup(context);
+  PlanningProblem resolved;
+  const PlanningProblem* solved = &problem;
   if (needs_configurations(problem.goal) && !problem.goal.resolved) {
-    PlanningProblem resolved = problem;
+    resolved = problem;
     resolve_goal(context.sim, ws, resolved.start, resolved.seed, resolved.goal, context.end_poses);
-    validate_problem(context.sim, ws, resolved);
-    return p->solve(resolved, ws, pool);
+    solved = &resolved;
   }
-  validate_problem(context.sim, ws, problem);
-  return p->solve(problem, ws, pool);
+  validate_problem(context.sim, ws, *solved);
+  if (solved->goal.contains(context.sim.robot, ws.robot, solved->start)) return start_in_goal();
+  return p->solve(*solved, ws, pool);
 }
 
 }  // namespace lazyboe
