@@ -468,7 +468,9 @@ TEST(TrajectoryCheck, CatchesATorqueOverTheLimit) {
 // lazyboe-robot validate-trajectory
 // ------------------------------------------------------------------------------------------
 
-CommandResult validate_cli(const std::string& csv, const std::string& extra = "") {
+// The trajectories here are planned in the bundled table scene (named by name); `extra` may name
+// another.
+CommandResult validate_cli(const std::string& csv, const std::string& extra = "--env table") {
   return run(quote(tool_path("lazyboe-robot")) + " validate-trajectory --in " + quote(csv) + " " +
              extra);
 }
@@ -479,6 +481,7 @@ TEST(ValidateTrajectoryCli, PrintsValidWithASummaryForARealEdge) {
   const CommandResult r = validate_cli(csv);
   EXPECT_EQ(r.exit_code, 0) << describe(r);
   EXPECT_EQ(count_lines(r.out), 1) << describe(r);
+  EXPECT_TRUE(contains(r.out, "; scene table")) << describe(r);
   EXPECT_TRUE(contains(r.out, "valid: " + std::to_string(real_edge().size()) + " samples"))
       << describe(r);
   for (const char* limit : {"position", "velocity", "acceleration", "jerk", "torque rate"})
@@ -574,6 +577,8 @@ TEST(ValidateTrajectoryCli, AMalformedFileGetsOneLineNamingFileAndLine) {
   const std::string gap = variant("gap.csv", 10, "0.029" + lines[10].substr(lines[10].find(',')));
   expect_one_line_error(validate_cli(gap), {gap + ":11", "control period"});
   expect_one_line_error(validate_cli(dir + "/missing.csv"), {dir + "/missing.csv"});
+  // The scene is named, never guessed (issue 30: a shelf trajectory passed against the table).
+  expect_one_line_error(validate_cli(gap, ""), {"--env", "name the scene"});
   write_bytes(dir + "/empty.csv", "");
   expect_one_line_error(validate_cli(dir + "/empty.csv"), {dir + "/empty.csv", "empty"});
 }

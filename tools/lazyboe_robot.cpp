@@ -329,6 +329,10 @@ int cmd_validate_trajectory(const RobotModel& bundle_robot, const std::string& e
           ? Payload{}
           : payload_from_json(task_field(payload_text, "--payload", doc), bundle_robot);
   const RobotModel robot = with_payload(bundle_robot, payload);
+  // A trajectory checked against another scene than its own says nothing: no default.
+  if (env_path.empty())
+    fail("--env", "name the scene the trajectory was planned in (an environment file, or a "
+                  "bundled scene: table, shelf, empty)");
   const Environment env = load_environment(env_path);
   const CollisionModel cm = build_collision_model(robot, env);
   const TrajectoryCsv traj = read_trajectory_csv(in, robot.dof);
@@ -353,11 +357,12 @@ int cmd_validate_trajectory(const RobotModel& bundle_robot, const std::string& e
   TrajectoryCheckWorkspace ws(checker);
   const TrajectoryCheckResult r = check_trajectory(checker, ws, traj.view());
   if (r.valid) {
-    std::printf("valid: %s\n", check_summary(r).c_str());
+    std::printf("valid: %s; scene %s\n", check_summary(r).c_str(), env.name.c_str());
     return 0;
   }
-  std::printf("invalid: %s (%s line %d)\n", describe_violation(checker, r.violation).c_str(),
-              in.c_str(), traj.line[r.violation.sample]);
+  std::printf("invalid: %s (%s line %d; scene %s)\n",
+              describe_violation(checker, r.violation).c_str(), in.c_str(),
+              traj.line[r.violation.sample], env.name.c_str());
   return kInvalidTrajectory;
 }
 
@@ -467,7 +472,10 @@ int main(int argc, char** argv) {
       "Check a trajectory CSV at the control rate against the limits and for collision");
   validate->add_option("--in", in_path, "CSV with header t,q1..qn,dq1..dqn[,more columns]")
       ->required();
-  validate->add_option("--env", env_path, "Environment (JSON)")->capture_default_str();
+  std::string validate_env;
+  validate->add_option("--env", validate_env,
+                       "The scene the trajectory was planned in: an environment file, or a "
+                       "bundled scene by name (table, shelf, empty); required");
   std::string payload_text, limits_text;
   validate->add_option("--payload", payload_text,
                        "The payload the arm carries, as a query's \"payload\" (JSON text)");
@@ -495,7 +503,7 @@ int main(int argc, char** argv) {
     if (*torques) return cmd_torques(robot, in_path, out_path);
     if (*check) return cmd_check(robot, env_path, in_path, out_path);
     if (*validate)
-      return cmd_validate_trajectory(robot, env_path, in_path, payload_text, limits_text);
+      return cmd_validate_trajectory(robot, validate_env, in_path, payload_text, limits_text);
     return cmd_allowed_pairs(robot, samples, seed);
   });
 }

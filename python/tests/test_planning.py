@@ -153,7 +153,7 @@ def test_pose_goal_and_the_task_at_query_time(session, tmp_path):
     rows = [[t.t[k], *t.q[k], *t.dq[k]] for k in range(len(t.t))]
     csv.write_text(",".join(header) + "\n" + "".join(",".join(repr(float(v)) for v in row) + "\n"
                                                       for row in rows))
-    check = tool("lazyboe-robot", "validate-trajectory", "--in", csv, "--payload",
+    check = tool("lazyboe-robot", "validate-trajectory", "--in", csv, "--env", "table", "--payload",
                  json.dumps(payload), "--end-effector-limits", json.dumps(limits))
     assert check.stdout.startswith("valid"), check.stdout
     with pytest.raises(ValueError, match="payload.mass"):
