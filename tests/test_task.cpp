@@ -512,6 +512,12 @@ TEST(PoseGoal, InverseKinematicsReachesPosesOfTheRegion) {
     EXPECT_TRUE(((q.array() > f.robot.q_min.array()) && (q.array() < f.robot.q_max.array())).all());
   }
   EXPECT_GE(solved, 15);  // from one random seed each
+  // A position target alone (3 rows): reached too.
+  JointVector q = f.a;
+  PoseTarget position = pose_goal(f.robot, f.c).pose_target();
+  position.has_orientation = false;
+  ASSERT_TRUE(solve_ik(f.robot, d, position, q));
+  EXPECT_LE(tip_errors(f.robot, q, pose_goal(f.robot, f.c)).first, 0.2 * 0.01);
 }
 
 // The end-pose index answers as a scan would: the `count` edges whose end poses are nearest a

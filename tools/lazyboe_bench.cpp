@@ -53,7 +53,11 @@ void write_text(const fs::path& path, const std::string& text) {
 void draw_figures(const fs::path& out_dir, bool quiet) {
   // Debian's python3-matplotlib belongs to the system interpreter, whatever else is on PATH.
   const std::string python = fs::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
-  const std::string script = std::string(LAZYBOE_SCRIPTS_DIR) + "/plot-bench.py";
+  // Installed beside the data (<prefix>/share/lazyboe/scripts), else the source tree's.
+  const fs::path installed = fs::path(data_dir()) / "scripts" / "plot-bench.py";
+  const std::string script = fs::exists(installed)
+                                 ? installed.string()
+                                 : std::string(LAZYBOE_SCRIPTS_DIR) + "/plot-bench.py";
   const std::string command = python + " '" + script + "' '" + out_dir.string() + "'";
   if (std::system((python + " -c 'import matplotlib' > /dev/null 2>&1").c_str()) != 0) {
     std::fprintf(stderr,

@@ -51,8 +51,9 @@ bool solve_ik(const RobotModel& robot, RobotData& data, const PoseTarget& t, Joi
   const double weight = t.position_tolerance / t.orientation_tolerance;
   constexpr double kDamping = 0.05, kMaxStep = 0.3;  // m, rad per iteration
   const double inset = 1e-6;
-  Eigen::Matrix<double, 6, Eigen::Dynamic, 0, 6, kMaxDof> J(rows, n);
-  Eigen::Matrix<double, 6, 1> e;
+  // rows x n (3 rows for a position target): fixed capacity, no allocation.
+  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 6, kMaxDof> J(rows, n);
+  Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 6, 1> e(rows);
   for (int it = 0; it < max_iterations; ++it) {
     forward_kinematics(robot, data, q);
     const Pose pose = link_pose(robot, data, t.link);
@@ -70,10 +71,10 @@ bool solve_ik(const RobotModel& robot, RobotData& data, const PoseTarget& t, Joi
     }
     e.head<3>() = t.position - pose.p;
     if (rows == 6) e.tail<3>() = weight * orientation_residual(t, pose.R);
-    const Eigen::Matrix<double, 6, 6> A =
-        (J * J.transpose()).topLeftCorner(rows, rows) +
-        kDamping * kDamping * Eigen::Matrix<double, 6, 6>::Identity().topLeftCorner(rows, rows);
-    JointVector step = J.transpose() * A.llt().solve(e.head(rows));
+    Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 6, 6> A = J * J.transpose();
+    A.diagonal().array() += kDamping * kDamping;
+    JointVector step(n);
+    step.noalias() = J.transpose() * A.llt().solve(e);
     const double longest = step.cwiseAbs().maxCoeff();
     if (longest > kMaxStep) step *= kMaxStep / longest;
     q += step;

@@ -1,6 +1,7 @@
 #include "lazyboe/robot/robot_model.h"
 
 #include <console_bridge/console.h>
+#include <dlfcn.h>
 #include <tinyxml.h>
 #include <urdf_parser/urdf_parser.h>
 
@@ -233,9 +234,48 @@ bool RobotModel::is_allowed_pair(int link_a, int link_b) const {
   return std::binary_search(allowed_pairs.begin(), allowed_pairs.end(), key);
 }
 
+namespace {
+
+// An installed copy of the data beside the binary this code was linked into: <prefix>/share/
+// lazyboe above <prefix>/bin/<tool> or <prefix>/lib/python3.X/dist-packages/lazyboe/<module>.
+std::string installed_beside_binary() {
+  std::vector<std::filesystem::path> binaries;
+  Dl_info info;
+  if (dladdr(reinterpret_cast<void*>(&installed_beside_binary), &info) && info.dli_fname)
+    binaries.emplace_back(info.dli_fname);
+  binaries.emplace_back("/proc/self/exe");  // dli_fname of the main program may be argv[0]
+  for (const std::filesystem::path& binary : binaries) {
+    std::error_code error;
+    const std::filesystem::path dir = std::filesystem::canonical(binary, error).parent_path();
+    if (error) continue;
+    std::filesystem::path prefix;  // of the two installed layouts, else none
+    const std::string packages = dir.parent_path().filename().string();
+    if (dir.filename() == "bin") {
+      prefix = dir.parent_path();
+    } else if (dir.filename() == "lazyboe" &&
+               (packages == "dist-packages" || packages == "site-packages")) {
+      prefix = dir.parent_path().parent_path().parent_path().parent_path();
+    }
+    const std::filesystem::path data = prefix / "share" / "lazyboe";
+    if (!prefix.empty() && std::filesystem::is_regular_file(data / "robots" / "panda.json", error))
+      return data;
+  }
+  return "";
+}
+
+std::string find_data_dir() {
+  if (std::string beside = installed_beside_binary(); !beside.empty()) return beside;
+  std::error_code error;
+  if (std::filesystem::is_directory(LAZYBOE_DATA_DIR, error)) return LAZYBOE_DATA_DIR;
+  return LAZYBOE_INSTALLED_DATA_DIR;
+}
+
+}  // namespace
+
 std::string data_dir() {
   if (const char* env = std::getenv("LAZYBOE_DATA_DIR"); env && *env) return env;
-  return LAZYBOE_DATA_DIR;
+  static const std::string found = find_data_dir();
+  return found;
 }
 
 std::string default_robot_path() { return data_dir() + "/robots/panda.json"; }

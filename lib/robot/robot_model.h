@@ -159,7 +159,10 @@ RobotModel robot_from_json(const nlohmann::json& config, const std::string& conf
 std::vector<Joint> chain_joints(const std::string& urdf_path, const std::string& base_link,
                                 const std::string& tip_link);
 
-// The bundled data directory (LAZYBOE_DATA_DIR in the environment overrides the built-in one).
+// The bundled data directory (robots, scenes, sample queries): LAZYBOE_DATA_DIR in the
+// environment; else an installed copy beside the running tool or Python module
+// (<prefix>/share/lazyboe); else the source tree's data/ (a build tree); else the install
+// prefix's share/lazyboe (a program of the user's linked with the installed library).
 std::string data_dir();
 std::string default_robot_path();
 
