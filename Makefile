@@ -73,7 +73,11 @@ fuzz:
 	@cmake --build $(FUZZ_BUILD_DIR) -j$(JOBS) --target fuzz_targets
 	scripts/run-fuzz.sh $(FUZZ_BUILD_DIR) $(FUZZ_SECONDS) $(FUZZ_RUNS) $(FUZZ_TARGETS)
 
-demo: build
+# The build's output is kept in $(BUILD_DIR).build.log and shown only when it fails.
+demo: deps
+	@cmake -S . -B $(BUILD_DIR) -DCMAKE_BUILD_TYPE=Release > $(BUILD_DIR).cmake.log 2>&1 || (cat $(BUILD_DIR).cmake.log; exit 1)
+	@echo "Building (output in $(BUILD_DIR).build.log) ..."
+	@cmake --build $(BUILD_DIR) -j$(JOBS) > $(BUILD_DIR).build.log 2>&1 || (cat $(BUILD_DIR).build.log; exit 1)
 	@scripts/demo.sh $(BUILD_DIR)
 
 install: build

@@ -13,8 +13,11 @@ echo "== 1. Robot model: data/robots/panda.json"
 printf '   flange at the ready pose: '
 "$bin/lazyboe-robot" fk --q 0,-0.785,0,-2.356,0,1.571,0.785
 "$bin/lazyboe-robot" torques --in data/examples/states.csv --out "$out/torques.csv" 2>/dev/null
-echo "   inverse dynamics with friction of data/examples/states.csv:"
-paste -d' ' <(cut -d, -f1-7 data/examples/states.csv | sed 's/^/     q: /') <(sed 's/^/ -> tau: /' "$out/torques.csv") | column -t
+echo "   inverse dynamics with friction of data/examples/states.csv (q rad, dq rad/s; ddq in the file; tau N m):"
+paste -d' ' <(cut -d, -f1-7 data/examples/states.csv | sed 's/^/     q: /') \
+  <(cut -d, -f8-14 data/examples/states.csv | sed 's/^/ dq: /') \
+  <(awk -F, 'NR == 1 { print; next } { for (i = 1; i <= NF; i++) printf "%s%.2f", (i > 1 ? "," : ""), $i; print "" }' \
+     "$out/torques.csv" | sed 's/^/ -> tau: /') | column -t
 "$bin/lazyboe-robot" check --env data/environments/table.json --in data/examples/configs.csv --out "$out/check.csv" 2>/dev/null
 echo "   collision checks on table.json of data/examples/configs.csv:"
 paste -d, data/examples/configs.csv "$out/check.csv" | column -t -s, | sed 's/^/     /'
