@@ -76,8 +76,8 @@ void print_perturbation_summary(const Bundle& b, std::FILE* out) {
     std::fprintf(out,
                  "max end-state error per edge (rad): median %.3f, 90th percentile %.3f, max %.3f "
                  "(theta/2 = %.3f)\n"
-                 "  (how far the edge's end moved when it started up to theta away: an edge whose "
-                 "perturbed ends stay within theta/2 of its stored end is taken lazily)\n",
+                 "  (how far an edge's end moved when it started up to theta away; P_lazy_prop "
+                 "counts the starts whose end stayed within theta/2 of the stored end)\n",
                  qe.median, qe.p90, qe.max, p.theta / 2);
   }
   std::fprintf(out,
