@@ -31,7 +31,6 @@
 #include "lazyboe/bundle/bundle_file.h"
 #include "test_util.h"
 
-
 namespace lazyboe::test {
 namespace {
 
@@ -235,6 +234,9 @@ TEST(BuildCli, InterruptedBuildResumesToTheStraightBuild) {
   const CommandResult inspect = build_tool({"--inspect", out});
   EXPECT_EQ(inspect.exit_code, 0) << describe(inspect);
   EXPECT_TRUE(contains(inspect.out, "INCOMPLETE")) << inspect.out;
+  // A few edges in the whole region: most of it uncovered, and the report says what to do.
+  EXPECT_TRUE(contains(inspect.out, "outside the bundle's coverage. Build more edges (--edges)"))
+      << inspect.out;
   EXPECT_TRUE(contains(
       inspect.out, "edges " + std::to_string(partial.size()) + " of " + std::to_string(kLongEdges)))
       << inspect.out;

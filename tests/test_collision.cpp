@@ -231,6 +231,22 @@ TEST(Collision, BundledScenesByName) {
   }
 }
 
+// Robots too: `--robot ur5` is the bundled config; an unknown name lists the bundled robots.
+TEST(Collision, BundledRobotsByName) {
+  const RobotModel ur5 = load_robot("ur5");
+  EXPECT_EQ(std::filesystem::path(ur5.config_path).filename(), "ur5.json");
+  EXPECT_EQ(ur5.dof, 6);
+  if (std::filesystem::exists("no-such-robot")) return;  // a file of that name here
+  try {
+    load_robot("no-such-robot");
+    ADD_FAILURE() << "no-such-robot was loaded";
+  } catch (const Error& e) {
+    const std::string message = e.what();
+    EXPECT_EQ(message.rfind("no-such-robot: no such file, nor a bundled robot", 0), 0u) << message;
+    EXPECT_NE(message.find("panda, ur5"), std::string::npos) << message;
+  }
+}
+
 TEST(Collision, DerivedAllowedPairsAreAdjacentLinks) {
   const RobotModel& robot = test::panda();
   const AllowedPairsResult result = derive_allowed_pairs(robot, 2000, 1);

@@ -168,7 +168,7 @@ TEST(QueryCli, IncompleteMissingAndUnperturbedBundlesAreRefused) {
       jsonl({query("lazy", f.a, f.b, "lazyboe", 1, true), query("plain", f.a, f.b, "boe", 2, true),
              query("plain-sp", f.a, f.b, "lazysp", 2, true)}));
   const ToolRun t3 = query_tool({"--bundle", f.unperturbed, "--queries", batch, "--quiet"});
-  ASSERT_EQ(t3.r.exit_code, 0) << describe(t3.r);
+  ASSERT_EQ(t3.r.exit_code, 3) << describe(t3.r);  // some lines had errors, the others ran
   ASSERT_EQ(t3.results.size(), 3u) << describe(t3.r);
   EXPECT_EQ(t3.results[0].value("success", true), false);
   EXPECT_EQ(t3.results[0].value("line", -1), 1);
@@ -298,6 +298,7 @@ TEST(QueryCli, CsvTrajectoryIdsMustNameAFileInTheDirectory) {
   const ToolRun t = run_batch("csv-ids", queries,
                               {"--trajectories", "csv", "--trajectory-dir", traj_dir, "--quiet"});
   ASSERT_EQ(t.results.size(), 3u) << describe(t.r);
+  EXPECT_EQ(t.r.exit_code, 3) << describe(t.r);  // some lines had errors
   for (size_t i = 0; i < 2; ++i) {
     EXPECT_TRUE(contains(t.results[i].value("error", ""), "cannot name a file"))
         << t.results[i].dump();
@@ -511,7 +512,8 @@ TEST(QueryCli, StartOrGoalOutsideTheCoverageFailsWithAReason) {
             << (t.results.size() < 2 ? "" : t.results[1].value("failure", "")) << "\n";
 }
 
-// The summary on stderr counts what was solved and never rounds a failure up to 100%.
+// The summary on stderr counts what was solved, never rounds a failure up to 100%, shows a
+// planner that solved nothing with dashes, and names the leading failure reason.
 TEST(QueryCli, TheSummaryCountsTheSolvedQueries) {
   const Fixture& f = fixture();
   const JointVector far_start = far_start_state(f);
@@ -519,9 +521,13 @@ TEST(QueryCli, TheSummaryCountsTheSolvedQueries) {
   const ToolRun t =
       run_batch("summary",
                 {query("ok-1", f.a, f.b, "boe", 5, true), query("ok-2", f.b, f.a, "boe", 5, true),
-                 query("far", far_start, f.b, "boe", 3, false)},
+                 query("far", far_start, f.b, "boe", 3, false),
+                 query("far-lazy", far_start, f.b, "lazyboe", 3, false)},
                 {});
   ASSERT_EQ(t.r.exit_code, 0) << describe(t.r);
+  EXPECT_TRUE(contains(t.r.err, "1 failed, most often: ")) << t.r.err;
+  const std::string failure = t.results.size() > 2 ? t.results[2].value("failure", "?") : "?";
+  EXPECT_TRUE(contains(t.r.err, "most often: " + failure)) << t.r.err;
   EXPECT_TRUE(contains(t.r.err, "solved")) << t.r.err;
   std::istringstream lines(t.r.err);
   bool found = false;
@@ -536,6 +542,19 @@ TEST(QueryCli, TheSummaryCountsTheSolvedQueries) {
     EXPECT_EQ(percent, "66.6%") << line;  // rounded down
   }
   EXPECT_TRUE(found) << t.r.err;
+  // lazyboe solved nothing: dashes where its figures would be.
+  const auto dashed = [&] {
+    std::istringstream rows(t.r.err);
+    for (std::string line; std::getline(rows, line);) {
+      std::istringstream row(line);
+      std::string planner, queries, solved, percent, median, mean, cost;
+      if (row >> planner >> queries >> solved >> percent >> median >> mean >> cost &&
+          planner == "lazyboe")
+        return solved == "0" && percent == "0.0%" && median == "-" && mean == "-" && cost == "-";
+    }
+    return false;
+  };
+  EXPECT_TRUE(dashed()) << t.r.err;
 }
 
 }  // namespace

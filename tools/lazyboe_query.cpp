@@ -3,6 +3,7 @@
 // re-validated end to end.
 #include <omp.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -39,6 +40,7 @@ struct Outcome {
   std::string planner;
   bool success = false;
   double ttfs = 0, cost = 0;
+  std::string failure;  // why there is no solution
   bool error = false;
 };
 
@@ -161,6 +163,7 @@ std::pair<std::string, Outcome> answer(const Job& job, const std::string& text, 
     o.success = r.success;
     o.ttfs = r.time_to_first_solution;
     o.cost = r.success ? a.trajectory.cost : 0;
+    o.failure = r.failure;
   } catch (const std::exception& e) {  // Error, or anything else: never out of a job
     j = error_json(id, line, o.planner, e.what());
     o.error = true;
@@ -240,31 +243,51 @@ void print_summary(const std::vector<Outcome>& outcomes) {
                "success", "median TTFS s", "mean TTFS s", "mean cost");
   for (const auto& [name, list] : by_planner) {
     std::vector<double> ttfs, cost;
+    std::map<std::string, size_t> failures;
     for (const Outcome* o : list) {
-      if (!o->success) continue;
+      if (!o->success) {
+        ++failures[o->failure];
+        continue;
+      }
       ttfs.push_back(o->ttfs);
       cost.push_back(o->cost);
     }
-    const Quantiles qt = quantiles(ttfs), qc = quantiles(cost);
     // One decimal, rounded down: 2999 of 3000 is 99.9%, never 100%.
     const double percent = std::floor(1000.0 * ttfs.size() / list.size()) / 10;
-    std::fprintf(stderr, "%-11s %7zu %7zu %7.1f%% %14.4f %14.4f %10.3f\n", name.c_str(),
-                 list.size(), ttfs.size(), percent, qt.median, qt.mean, qc.mean);
+    std::fprintf(stderr, "%-11s %7zu %7zu %7.1f%%", name.c_str(), list.size(), ttfs.size(),
+                 percent);
+    if (ttfs.empty()) {  // no figures to show: dashes, not zeros that read like results
+      std::fprintf(stderr, " %14s %14s %10s\n", "-", "-", "-");
+    } else {
+      const Quantiles qt = quantiles(ttfs), qc = quantiles(cost);
+      std::fprintf(stderr, " %14.4f %14.4f %10.3f\n", qt.median, qt.mean, qc.mean);
+    }
+    if (!failures.empty()) {  // the leading reason, so a failure reads as one
+      const auto leading =
+          std::max_element(failures.begin(), failures.end(),
+                           [](const auto& a, const auto& b) { return a.second < b.second; });
+      std::fprintf(stderr, "%-11s %zu failed, most often: %s\n", "", list.size() - ttfs.size(),
+                   leading->first.c_str());
+    }
   }
   if (errors) std::fprintf(stderr, "%zu queries had errors (see their \"error\" field)\n", errors);
   std::fprintf(stderr, "resident memory %.0f MiB\n", resident_memory_mib());
 }
 
-// Every query of a non-empty batch had an error: the exit status says so (results are written).
-bool every_query_failed_to_parse(const std::vector<Outcome>& outcomes) {
-  for (const Outcome& o : outcomes)
-    if (!o.error) return false;
-  if (outcomes.empty()) return false;
+// The exit status of an answered batch (results written either way): 0 when every line was
+// planned (solved or not), 1 when every line of a non-empty batch had an error, and
+// kSomeLinesFailed when some had.
+constexpr int kSomeLinesFailed = 3;
+int batch_status(const std::vector<Outcome>& outcomes) {
+  const size_t errors = static_cast<size_t>(
+      std::count_if(outcomes.begin(), outcomes.end(), [](const Outcome& o) { return o.error; }));
+  if (errors == 0) return 0;
+  if (errors < outcomes.size()) return kSomeLinesFailed;
   std::fprintf(stderr,
                "lazyboe-query: every query had an error (%zu of %zu; see their \"error\" "
                "field)\n",
                outcomes.size(), outcomes.size());
-  return true;
+  return 1;
 }
 
 // The default --sim-threads: the cores left per job; a warning when jobs x threads exceed them.
@@ -308,7 +331,7 @@ int run(const Options& o) {
                             : answer_file(job, o.queries_path, out, o.jobs, sim_threads);
   if (file) file->commit();
   if (!o.quiet) print_summary(outcomes);
-  return every_query_failed_to_parse(outcomes) ? 1 : 0;
+  return batch_status(outcomes);
 }
 
 }  // namespace

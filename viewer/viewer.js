@@ -331,8 +331,12 @@
   allPaths.addAttribute('position', new THREE.BufferAttribute(new Float32Array(segments), 3));
   allPaths.addAttribute('color', new THREE.BufferAttribute(new Float32Array(segmentColours), 3));
   scene.add(new THREE.LineSegments(allPaths, new THREE.LineBasicMaterial({
-    vertexColors: THREE.VertexColors, transparent: true, opacity: 0.4, depthWrite: false})));
-  const selectedPath = new THREE.Line(new THREE.BufferGeometry(), new THREE.LineBasicMaterial());
+    vertexColors: THREE.VertexColors, transparent: true, opacity: 0.6, depthWrite: false})));
+  // The selected path is drawn last and over everything (no depth test): never hidden by the
+  // bundle's points or an obstacle. (WebGL draws lines one pixel wide whatever linewidth says.)
+  const selectedPath = new THREE.Line(new THREE.BufferGeometry(),
+                                      new THREE.LineBasicMaterial({depthTest: false}));
+  selectedPath.renderOrder = 10;
   selectedPath.visible = false;
   scene.add(selectedPath);
   if (!results) say('No results file given (lazyboe-view --results): robot and obstacles only.');
@@ -524,9 +528,17 @@
     const g = new THREE.BufferGeometry();
     g.addAttribute('position', new THREE.BufferAttribute(new Float32Array(bundle.points), 3));
     g.addAttribute('color', new THREE.BufferAttribute(new Float32Array(3 * n), 3));
-    bundlePoints = new THREE.Points(g, new THREE.PointsMaterial({size: 4, sizeAttenuation: false,
+    bundlePoints = new THREE.Points(g, new THREE.PointsMaterial({size: 3, sizeAttenuation: false,
                                                                  vertexColors: THREE.VertexColors}));
     scene.add(bundlePoints);
+    // Shown by default only when there is no trajectory to look at: thousands of points would
+    // cover the planned paths.
+    bundlePoints.visible = trajectories.length === 0;
+    $('show-bundle').checked = bundlePoints.visible;
+    $('show-bundle').addEventListener('change', (e) => {
+      bundlePoints.visible = e.target.checked;
+      stillLayers.changed();
+    });
     const fields = Object.keys(ramps).filter((f) => Array.isArray(bundle[f]));
     for (const f of fields) {
       const o = document.createElement('option');
@@ -595,6 +607,25 @@
     return {x0: Math.min(...xs), y0: Math.min(...ys), x1: Math.max(...xs), y1: Math.max(...ys)};
   }
 
+  // The camera frames the robot (at zero) and every planned path, from behind the robot's
+  // right shoulder: a shelf or a table in front of the robot is seen from the robot's side,
+  // not from behind its back panel.
+  function frameView() {
+    const box = new THREE.Box3().setFromObject(mainRobot.group);
+    const p = new THREE.Vector3();
+    for (const tr of trajectories) {
+      for (let k = 0; k < tr.pathPoints.length; k += 3)
+        box.expandByPoint(p.fromArray(tr.pathPoints, k));
+    }
+    const centre = box.getCenter(new THREE.Vector3());
+    const radius = Math.max(0.4, box.getSize(new THREE.Vector3()).length() / 2);
+    const distance = 1.1 * radius / Math.sin(THREE.Math.degToRad(camera.fov / 2));
+    controls.target.copy(centre);
+    camera.position.copy(centre).addScaledVector(new THREE.Vector3(-1.0, -1.1, 0.9).normalize(), distance);
+    controls.update();
+  }
+  frameView();
+
   window.lazyboeView = {
     // Every link's pose at q: what the page draws, compared with lazyboe-robot fk by the tests.
     linkPoses: (q) => linkPoses(robot, q).map((p, i) => ({link: robot.links[i].name, position: p.p,
@@ -611,6 +642,20 @@
     setSpeed(s) { play.speed = s; },
     select: select,
     goalView: goalView,
+    bundleShown: () => (bundlePoints ? bundlePoints.visible : null),
+    // The share of the planned paths' points inside the view (the default camera frames them).
+    pathsOnScreen() {
+      camera.updateMatrixWorld();
+      let inside = 0, all = 0;
+      const p = new THREE.Vector3();
+      for (const tr of trajectories) {
+        for (let k = 0; k < tr.pathPoints.length; k += 3, ++all) {
+          p.fromArray(tr.pathPoints, k).project(camera);
+          inside += Math.abs(p.x) <= 1 && Math.abs(p.y) <= 1 ? 1 : 0;
+        }
+      }
+      return all ? inside / all : 1;
+    },
     messages: messages,
     renderer: rendererName,
     stillLayersCached: stillLayers.cached,

@@ -161,6 +161,27 @@ std::string checksum_summary(const std::vector<DatasetVerification>& checks) {
   return "all " + std::to_string(verified) + " datasets verify";
 }
 
+namespace {
+
+// What the coverage figures mean for a user, in a line, when they call for something (issue 30).
+void print_coverage_advice(double uncovered, double median, std::FILE* out) {
+  if (uncovered > 0.10) {  // the default 100k bundle: 5.8% (docs/bundle.md)
+    std::fprintf(out,
+                 "  -> %.0f%% of the region has no edge start within theta: a query starting "
+                 "there fails as outside the bundle's coverage. Build more edges (--edges), raise "
+                 "--theta, narrow --region to where you plan, or plan with lazysp (its growth "
+                 "leaves the bundle)\n",
+                 100.0 * uncovered);
+  } else if (median < 10) {
+    std::fprintf(out,
+                 "  -> a median of %.0f edge starts per point: the bundle planners have few edges "
+                 "to choose from; more edges (--edges) or a larger --theta help\n",
+                 median);
+  }
+}
+
+}  // namespace
+
 void print_inspection(const std::string& path, std::FILE* out) {
   const Bundle b = read_bundle(path);
   const BundleHeader& h = b.header;
@@ -226,6 +247,7 @@ void print_inspection(const std::string& path, std::FILE* out) {
                "edge starts within theta = %g of 500 random region points: mean %.1f, median %.0f, "
                "10th percentile %.0f, none for %.1f%% of points\n",
                h.design_theta, qn.mean, qn.median, qn.p10, 100.0 * zero / counts.size());
+  print_coverage_advice(static_cast<double>(zero) / counts.size(), qn.median, out);
   std::fputs("\n", out);
   print_perturbation_summary(b, out);
 }

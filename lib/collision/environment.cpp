@@ -5,6 +5,7 @@
 #include <set>
 
 #include "lazyboe/common/error.h"
+#include "lazyboe/common/file_checks.h"
 #include "lazyboe/common/hash.h"
 #include "lazyboe/common/json_fields.h"
 #include "lazyboe/common/numbers.h"
@@ -25,24 +26,9 @@ const RealRange kQuaternionComponent{-1e3, 1e3};
 std::string default_environment_path() { return data_dir() + "/environments/table.json"; }
 
 std::string resolve_environment_path(const std::string& path) {
-  namespace fs = std::filesystem;
-  std::error_code ec;
-  if (path.empty() || fs::exists(path, ec)) return path;
-  const fs::path given(path);
   // A path or a file name is a file: never silently another one (a missing table.json is not
   // the bundled table). Only a bare name ("shelf") names a bundled scene.
-  if (given.has_parent_path() || given.has_extension()) return path;
-  const fs::path dir = fs::path(data_dir()) / "environments";
-  const fs::path bundled = dir / (path + ".json");
-  if (fs::exists(bundled, ec)) return bundled.string();
-  std::vector<std::string> found;
-  for (const auto& entry : fs::directory_iterator(dir, ec))
-    if (entry.path().extension() == ".json") found.push_back(entry.path().stem().string());
-  std::sort(found.begin(), found.end());
-  std::string names;
-  for (const std::string& name : found) names += (names.empty() ? "" : ", ") + name;
-  fail(path, "no such file, nor a bundled scene of that name (" +
-                 (names.empty() ? std::string("none found in ") + dir.string() : names) + ")");
+  return resolve_bundled_file(path, data_dir() + "/environments", "scene");
 }
 
 Environment load_environment(const std::string& path) {

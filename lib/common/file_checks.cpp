@@ -3,8 +3,11 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
+#include <filesystem>
+#include <vector>
 
 #include "lazyboe/common/error.h"
 
@@ -36,6 +39,25 @@ void refuse_output_as_input(const NamedPath& out, const std::vector<NamedPath>& 
            "is the same file as the input " + in.option + " " + in.path +
                ": an output never replaces an input (choose another output path)");
   }
+}
+
+std::string resolve_bundled_file(const std::string& path, const std::string& dir,
+                                 const std::string& kind) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (path.empty() || fs::exists(path, ec)) return path;
+  const fs::path given(path);
+  if (given.has_parent_path() || given.has_extension()) return path;
+  const fs::path bundled = fs::path(dir) / (path + ".json");
+  if (fs::exists(bundled, ec)) return bundled.string();
+  std::vector<std::string> found;
+  for (const auto& entry : fs::directory_iterator(dir, ec))
+    if (entry.path().extension() == ".json") found.push_back(entry.path().stem().string());
+  std::sort(found.begin(), found.end());
+  std::string names;
+  for (const std::string& name : found) names += (names.empty() ? "" : ", ") + name;
+  fail(path, "no such file, nor a bundled " + kind + " of that name (" +
+                 (names.empty() ? "none found in " + dir : names) + ")");
 }
 
 }  // namespace lazyboe

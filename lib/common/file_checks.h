@@ -27,4 +27,11 @@ struct NamedPath {
 // empty paths are skipped.
 void refuse_output_as_input(const NamedPath& out, const std::vector<NamedPath>& inputs);
 
+// `path` as given when it exists, or is a path or a file name (it has a folder or an
+// extension: never silently another file); a bare name ("shelf") names the bundled
+// `dir`/<name>.json. Throws Error naming `path`, what it is not (`kind`: "scene", "robot") and
+// the bundled names, when there is none of that name.
+std::string resolve_bundled_file(const std::string& path, const std::string& dir,
+                                 const std::string& kind);
+
 }  // namespace lazyboe

@@ -562,7 +562,8 @@ std::vector<Joint> chain_joints(const std::string& urdf_path, const std::string&
 }
 
 RobotModel load_robot(const std::string& config_path) {
-  return robot_from_json(load_json_file(config_path), config_path);
+  const std::string path = resolve_bundled_file(config_path, data_dir() + "/robots", "robot");
+  return robot_from_json(load_json_file(path), path);
 }
 
 RobotModel robot_from_json(const nlohmann::json& config, const std::string& config_path) {

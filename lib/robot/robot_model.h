@@ -147,8 +147,9 @@ class JsonField;
 // field for an unknown one (unknown_link's text).
 int link_field(const JsonField& object, const RobotModel& robot);
 
-// Loads a robot config (JSON) and the URDF it points at. Throws Error naming the file and
-// field for anything missing, malformed or not physical.
+// Loads a robot config (JSON; or a bundled robot by name: "panda", "ur5") and the URDF it
+// points at. Throws Error naming the file and field for anything missing, malformed or not
+// physical.
 RobotModel load_robot(const std::string& config_path);
 // The same for a config held in memory; `config_path` names it in errors and is where its
 // relative paths (urdf, package_path) start.

@@ -290,6 +290,12 @@ def main():
         check("a (lazysp, line 1): success, cost 1.00, duration 1.00 s" in text and "edges 3 5" in text,
               "main page: the selected trajectory's id, planner, line, cost, duration and edges are shown")
         nonblank_robot(browser, os.path.join(out_dir, "viewer.png"), "main page")
+        check(browser.evaluate("lazyboeView.pathsOnScreen()") == 1,
+              "main page: the default camera frames every planned path")
+        check(browser.evaluate("lazyboeView.bundleShown()") is False,
+              "main page: the bundle sample is hidden while there are trajectories to look at")
+        browser.evaluate("document.getElementById('show-bundle').click()")
+        check(browser.evaluate("lazyboeView.bundleShown()") is True, "main page: its toggle shows it")
         rng = random.Random(17)
         configurations = [READY, OTHER, THIRD] + [[rng.uniform(-2.5, 2.5) for _ in range(7)] for _ in range(2)]
         compare_fk(browser, bin_dir, configurations)

@@ -90,7 +90,8 @@ PlanResult BundleSearch::run() {
   }
   PlanResult& r = s_.result();
   if (!r.success && r.failure.empty()) {
-    r.failure = open_.empty() ? "search exhausted: no more nodes to expand within the bundle"
+    r.failure = open_.empty() ? "search exhausted: no more nodes to expand within the bundle "
+                                "(try lazysp, whose growth leaves the bundle, or a larger theta)"
                               : s_.stop_failure();
   }
   return r;
