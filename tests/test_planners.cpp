@@ -436,8 +436,22 @@ TEST(Planners, StartOrGoalOutsideTheCoverageFailsWithAReason) {
       EXPECT_TRUE(contains(r.failure, "bundle")) << "failure: " << r.failure;
       EXPECT_TRUE(contains(r.failure, start_is_far ? "start" : "goal")) << "failure: " << r.failure;
       EXPECT_FALSE(contains(r.failure, "time budget")) << "failure: " << r.failure;
+      // What puts it out of reach: a joint outside the region, or the nearest edge's distance.
+      EXPECT_TRUE(contains(r.failure, "the bundle's region [") ||
+                  contains(r.failure, start_is_far ? "nearest edge start is" : "nearest edge"))
+          << "failure: " << r.failure;
     }
   }
+  // A start outside the sampling region (joint 2 below it, like the Panda's ready pose): the
+  // failure names the joint, its value and the region's bounds.
+  JointVector low = f.a;
+  low[1] = context.sample_lower[1] - 0.6;
+  ASSERT_EQ(check_state(f.sim, ws, low), RolloutStatus::Valid) << "the test's start collides";
+  const PlanResult r =
+      plan(context, ws, "lazyboe", searching("lazyboe"), library_problem(low, f.b, 5));
+  EXPECT_FALSE(r.success);
+  EXPECT_TRUE(contains(r.failure, "joint 2 (panda_joint2) is ")) << r.failure;
+  EXPECT_TRUE(contains(r.failure, "the bundle's region [")) << r.failure;
 }
 
 TEST(Planners, ALazyChainWithoutProgressEnds) {

@@ -708,5 +708,25 @@ TEST(TaskInput, BadFieldsAreOneLineNamingTheField) {
   EXPECT_EQ(query_error({{"payload", {{"mass", 1}}}}), "");
 }
 
+// A pose goal every configuration of which tilts the carried container beyond the limit is
+// refused for that reason, not as "in collision".
+TEST(TaskInput, APoseGoalTiltedBeyondTheLimitIsRefusedAsTilted) {
+  const Fixture& f = fixture();
+  const Pose at_start = tip_pose(f.robot, f.a);
+  const Eigen::Quaterniond tilted(Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitX()) * at_start.R);
+  const json goal = {{"pose",
+                      {{"position", vec(at_start.p)},
+                       {"orientation", {tilted.w(), tilted.x(), tilted.y(), tilted.z()}}}}};
+  const std::string error =
+      query_error({{"goal", goal}, {"end_effector_limits", {{"max_tilt", 0.2}}}});
+  EXPECT_EQ(error.rfind("line 1: goal.pose: every configuration found that reaches it (", 0), 0u)
+      << error;
+  EXPECT_NE(error.find("'s axis beyond end_effector_limits.max_tilt 0.2 rad: the goal's own "
+                       "orientation is tilted more than that"),
+            std::string::npos)
+      << error;
+  EXPECT_EQ(query_error({{"goal", goal}}), "");  // without the limit it is a fine goal
+}
+
 }  // namespace
 }  // namespace lazyboe::test

@@ -357,6 +357,19 @@ StudyInfo study_info(const BenchOptions& o, const PlanningSession& session,
   return info;
 }
 
+// The exit status for a script: 0 every run ended (solved or not), kSomeRunsFailed when some
+// runs ended in an error (runs.csv's failure column says which and why).
+constexpr int kSomeRunsFailed = 3;
+
+int errors_status(const std::vector<RunRecord>& runs, const StudyPaths& paths) {
+  size_t errors = 0;
+  for (const RunRecord& r : runs) errors += r.failure.rfind("error: ", 0) == 0;
+  if (errors == 0) return 0;
+  std::fprintf(stderr, "lazyboe-bench: %zu of %zu runs ended in an error (%s's failure column)\n",
+               errors, runs.size(), paths.runs.c_str());
+  return kSomeRunsFailed;
+}
+
 int run(const BenchOptions& o, const std::string& command_line) {
   const StudyPaths paths{fs::path(o.out_dir)};
   check_out_dir(o, paths);
@@ -425,7 +438,7 @@ int run(const BenchOptions& o, const std::string& command_line) {
   const StudyInfo info =
       study_info(o, session, context, *world, problems, problems_source, command_line);
   write_results(o, paths, info, specs, runs, problem_ids);
-  return 0;
+  return errors_status(runs, paths);
 }
 
 }  // namespace

@@ -53,7 +53,9 @@ void resolve_pose(const Simulator& sim, SimulatorWorkspace& ws, const JointVecto
     ++goal.attempts;
     if (!solve_ik(robot, ws.robot, target, q)) continue;
     ++goal.reached;
-    if (check_state(sim, ws, q) == RolloutStatus::Valid) goal.configurations.push_back(q);
+    const RolloutStatus status = check_state(sim, ws, q);
+    if (status == RolloutStatus::Valid) goal.configurations.push_back(q);
+    if (status == RolloutStatus::EndEffectorTilt) ++goal.tilted;
   }
 }
 
@@ -66,7 +68,7 @@ bool needs_configurations(const Goal& goal) {
 void resolve_goal(const Simulator& sim, SimulatorWorkspace& ws, const JointVectorRef& start,
                   uint64_t seed, Goal& goal, const EndPoseIndexes* coverage) {
   goal.configurations.clear();
-  goal.reached = goal.attempts = 0;
+  goal.reached = goal.attempts = goal.tilted = 0;
   if (goal.kind == Goal::Kind::Pose) resolve_pose(sim, ws, start, seed, coverage, goal);
   for (Goal& m : goal.members) {
     if (m.kind == Goal::Kind::Joint) {

@@ -126,12 +126,24 @@ ProblemIssue pose_issue(const Simulator& sim, SimulatorWorkspace& ws, const std:
             "no configuration within the joint limits reaches it within the tolerances (" +
                 std::to_string(g.attempts) + " attempts of inverse kinematics)"};
   }
-  // Every configuration found that reaches it collides: the link there touches an obstacle
-  // (or the arm itself) whichever way the arm reaches it, as far as the search saw.
+  // Every configuration found that reaches it collides (the link there touches an obstacle, or
+  // the arm itself, whichever way the arm reaches it, as far as the search saw) or tilts the
+  // carried container beyond the task's limit.
   if (g.resolved && g.configurations.empty()) {
-    return {field + ".pose", "every configuration found that reaches it (" +
-                                 std::to_string(g.reached) + " in " + std::to_string(g.attempts) +
-                                 " attempts of inverse kinematics) is in collision"};
+    const std::string found = "every configuration found that reaches it (" +
+                              std::to_string(g.reached) + " in " + std::to_string(g.attempts) +
+                              " attempts of inverse kinematics) ";
+    if (g.tilted == 0) return {field + ".pose", found + "is in collision"};
+    char tilt[160];
+    std::snprintf(tilt, sizeof tilt, "end_effector_limits.max_tilt %.3g rad",
+                  sim.end_effector.max_tilt);
+    if (g.tilted == g.reached)
+      return {field + ".pose", found + "tilts " + sim.robot.links[sim.end_effector.link].name +
+                                   "'s axis beyond " + tilt +
+                                   ": the goal's own orientation is tilted more than that"};
+    return {field + ".pose", found + "is in collision (" + std::to_string(g.reached - g.tilted) +
+                                 ") or tilted beyond " + tilt + " (" + std::to_string(g.tilted) +
+                                 ")"};
   }
   return {};
 }

@@ -41,10 +41,11 @@ struct Goal {
   std::vector<Goal> members;
   // Pose goals and sets (resolve_goal): configurations inside the goal region, within the joint
   // limits and free of collision, nearest the start first, which direct commands aim at; and
-  // how many attempts of inverse kinematics reached the goal at all.
+  // how many attempts of inverse kinematics reached the goal at all, and how many of those were
+  // tilted beyond the task's end-effector limit (the others that were left out collide).
   std::vector<JointVector> configurations;
   bool resolved = false;
-  int reached = 0, attempts = 0;
+  int reached = 0, attempts = 0, tilted = 0;
 
   PoseTarget pose_target() const;  // Position, Pose
   // The configuration nearest q (Euclidean in joint space) and its distance; null and infinity

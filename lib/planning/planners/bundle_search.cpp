@@ -1,12 +1,46 @@
 #include "lazyboe/planning/planners/bundle_search.h"
 
 #include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <string>
 
 namespace lazyboe {
 namespace {
 
 JointVector row(const double* p, int n) { return Eigen::Map<const Eigen::VectorXd>(p, n); }
+
+// What puts q out of the bundle's reach, for a coverage failure: the joints outside the bundle's
+// sampling region, or else how far the nearest edge start (end, for `ends`) lies.
+std::string coverage_hint(const PlanningContext& ctx, const JointVectorRef& q, bool ends) {
+  std::string hint;
+  const JointVector& lo = ctx.sample_lower;
+  const JointVector& hi = ctx.sample_upper;
+  for (int i = 0; i < q.size() && lo.size() == q.size() && hi.size() == q.size(); ++i) {
+    if (q[i] >= lo[i] && q[i] <= hi[i]) continue;
+    char text[160];
+    std::snprintf(text, sizeof text, "%sjoint %d (%s) is %.3f, the bundle's region [%.3f, %.3f]",
+                  hint.empty() ? "" : "; ", i + 1, ctx.sim.robot.joints[i].name.c_str(), q[i],
+                  lo[i], hi[i]);
+    hint += text;
+  }
+  if (!hint.empty()) return hint;
+  const EdgeIndex* index = ends ? ctx.end_index : ctx.index;
+  if (!index) return "inside the bundle's region, but no edge is near";
+  std::vector<std::pair<uint32_t, double>> found;
+  for (double radius = std::max(ctx.theta, 0.05); radius < 64; radius *= 2) {
+    index->within(q.data(), radius, found);
+    if (found.empty()) continue;
+    double nearest = found.front().second;
+    for (const auto& f : found) nearest = std::min(nearest, f.second);
+    char text[120];
+    std::snprintf(text, sizeof text,
+                  "inside the bundle's region; the nearest edge %s is %.3f rad away",
+                  ends ? "end" : "start", std::sqrt(nearest));
+    return text;
+  }
+  return "inside the bundle's region, but no edge is near";
+}
 
 }  // namespace
 
@@ -102,9 +136,10 @@ bool BundleSearch::covered(Neighbours& neighbours) {
   ctx_.index->within(s_.problem().start.data(), theta_, neighbours);
   if (neighbours.empty()) {
     s_.result().failure = "no bundle edge starts within theta = " + std::to_string(theta_) +
-                          " rad of the start: it is outside the bundle's coverage (try lazysp, "
-                          "whose growth leaves the bundle; a larger theta; or a bundle whose "
-                          "--region holds the start: lazyboe-build --inspect shows its region)";
+                          " rad of the start: it is outside the bundle's coverage (" +
+                          coverage_hint(ctx_, s_.problem().start, false) +
+                          "); try lazysp, whose growth leaves the bundle; a larger theta; or a "
+                          "bundle built with a --region that holds the start";
     return false;
   }
   const Goal& goal = s_.problem().goal;
@@ -112,8 +147,10 @@ bool BundleSearch::covered(Neighbours& neighbours) {
   const double reach = theta_ + goal.tolerance;
   if (edge_ends_near(ctx_, goal.q, reach, neighbours)) return true;
   s_.result().failure = "no bundle edge ends within theta + tolerance = " + std::to_string(reach) +
-                        " rad of the goal: it is outside the bundle's coverage (try lazysp, a "
-                        "larger theta or tolerance, or a bundle whose --region holds the goal)";
+                        " rad of the goal: it is outside the bundle's coverage (" +
+                        coverage_hint(ctx_, goal.q, ctx_.end_index != nullptr) +
+                        "); try lazysp, a larger theta or tolerance, or a bundle built with a "
+                        "--region that holds the goal";
   return false;
 }
 
