@@ -231,6 +231,26 @@ TEST(Collision, BundledScenesByName) {
   }
 }
 
+// The docs' paths ("data/environments/shelf.json") from a folder without data/: the bundled
+// file; a path under data/ the bundled data does not have stays an error naming it.
+TEST(Collision, TheDocsDataPathsWorkFromAnyFolder) {
+  namespace fs = std::filesystem;
+  const fs::path here = fs::current_path();
+  const fs::path elsewhere = fs::path(test::temp_dir()) / "no-data-here";
+  fs::create_directories(elsewhere);
+  fs::current_path(elsewhere);
+  std::string identity, missing_error;
+  try {
+    identity = load_environment("data/environments/shelf.json").identity;
+    load_environment("data/environments/no-such-scene.json");
+  } catch (const Error& e) {
+    missing_error = e.what();
+  }
+  fs::current_path(here);
+  EXPECT_EQ(identity, env_file("shelf").identity);
+  EXPECT_EQ(missing_error.rfind("data/environments/no-such-scene.json:", 0), 0u) << missing_error;
+}
+
 // Robots too: `--robot ur5` is the bundled config; an unknown name lists the bundled robots.
 TEST(Collision, BundledRobotsByName) {
   const RobotModel ur5 = load_robot("ur5");

@@ -107,8 +107,8 @@ TEST(QueryCli, MemoryMappedAndReadIntoMemoryGiveIdenticalAnswers) {
   EXPECT_TRUE(contains(loud.r.err, "read into memory")) << loud.r.err;
 }
 
-// A JSON array, as pretty-printed JSON tools write one, is one clear error for the file (not one
-// "not valid JSON" result per line), and nothing is written.
+// A JSON array, as pretty-printed JSON tools write one, or a pretty-printed object, is one clear
+// error for the file (not one "not valid JSON" result per line), and nothing is written.
 TEST(QueryCli, AJsonArrayIsOneErrorNamingTheFormat) {
   const Fixture& f = fixture();
   const nlohmann::json batch = {query("a", f.a, f.b, "boe", 1, true),
@@ -119,6 +119,13 @@ TEST(QueryCli, AJsonArrayIsOneErrorNamingTheFormat) {
       query_tool({"--bundle", f.path, "--queries", file, "--out", dir + "/r.jsonl", "--quiet"});
   expect_one_line_error(t.r, {file, "line 1: a JSON array", "JSON Lines", "jq -c"});
   EXPECT_EQ(files_in(dir), std::vector<std::string>{"batch.json"});
+  // One query pretty-printed over several lines, likewise.
+  const std::string pretty = write_temp_file("array/one.json", batch[0].dump(2) + "\n");
+  const ToolRun p =
+      query_tool({"--bundle", f.path, "--queries", pretty, "--out", dir + "/r.jsonl", "--quiet"});
+  expect_one_line_error(p.r,
+                        {pretty, "line 1: a JSON object over lines 1-", "JSON Lines", "jq -c ."});
+  EXPECT_EQ(files_in(dir), (std::vector<std::string>{"batch.json", "one.json"}));
 }
 
 TEST(QueryCli, IncompleteMissingAndUnperturbedBundlesAreRefused) {

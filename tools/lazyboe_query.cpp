@@ -189,15 +189,29 @@ std::vector<Outcome> answer_stream(const Job& job, std::ostream& out, int sim_th
 }
 
 // A file: `jobs` queries at a time, results in input order.
-// A JSON array (pretty-printed or not) is not JSON Lines: one error for the file, not one per line.
-void refuse_json_array(const std::string& path,
-                       const std::vector<std::pair<int, std::string>>& lines) {
+// A JSON array (pretty-printed or not), or an object pretty-printed over several lines, is not
+// JSON Lines: one error for the file that says how to convert it, not one per line.
+void refuse_non_json_lines(const std::string& path,
+                           const std::vector<std::pair<int, std::string>>& lines) {
   if (lines.empty()) return;
   const std::string& first = lines.front().second;
-  if (first[first.find_first_not_of(" \t\r")] != '[') return;
-  fail(path, "line " + std::to_string(lines.front().first) +
-                 ": a JSON array; a query file is JSON Lines, one query object per line (jq -c "
-                 "'.[]' FILE converts an array)");
+  const std::string where = "line " + std::to_string(lines.front().first) + ": ";
+  const char opening = first[first.find_first_not_of(" \t\r")];
+  if (opening == '[') {
+    fail(path, where +
+                   "a JSON array; a query file is JSON Lines, one query object per line (jq -c "
+                   "'.[]' FILE converts an array)");
+  }
+  if (opening != '{' || nlohmann::json::accept(first)) return;
+  std::string object = first;
+  for (size_t k = 1; k < lines.size() && k < 200; ++k) {  // the first object's end, if near
+    object += "\n" + lines[k].second;
+    if (!nlohmann::json::accept(object)) continue;
+    fail(path, where + "a JSON object over lines " + std::to_string(lines.front().first) + "-" +
+                   std::to_string(lines[k].first) +
+                   "; a query file is JSON Lines, one query object per line (jq -c . FILE "
+                   "converts pretty-printed objects)");
+  }
 }
 
 std::vector<Outcome> answer_file(const Job& job, const std::string& path, std::ostream& out,
@@ -210,7 +224,7 @@ std::vector<Outcome> answer_file(const Job& job, const std::string& path, std::o
   for (int line = 1; std::getline(in, text); ++line) {
     if (text.find_first_not_of(" \t\r") != std::string::npos) lines.emplace_back(line, text);
   }
-  refuse_json_array(path, lines);
+  refuse_non_json_lines(path, lines);
   std::vector<Outcome> outcomes(lines.size());
   std::vector<SimulatorWorkspace> workspaces;
   std::vector<std::unique_ptr<RolloutPool>> pools;  // not movable: they own threads

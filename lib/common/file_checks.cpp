@@ -47,6 +47,12 @@ std::string resolve_bundled_file(const std::string& path, const std::string& dir
   std::error_code ec;
   if (path.empty() || fs::exists(path, ec)) return path;
   const fs::path given(path);
+  // The docs' paths ("data/environments/shelf.json"), run from another folder than the source
+  // tree's: the same file of the bundled data (`dir`'s parent is the data folder).
+  if (given.is_relative() && !given.empty() && *given.begin() == "data") {
+    const fs::path in_data = fs::path(dir).parent_path() / given.lexically_relative("data");
+    if (fs::exists(in_data, ec)) return in_data.string();
+  }
   if (given.has_parent_path() || given.has_extension()) return path;
   const fs::path bundled = fs::path(dir) / (path + ".json");
   if (fs::exists(bundled, ec)) return bundled.string();

@@ -29,8 +29,10 @@ void refuse_output_as_input(const NamedPath& out, const std::vector<NamedPath>& 
 
 // `path` as given when it exists, or is a path or a file name (it has a folder or an
 // extension: never silently another file); a bare name ("shelf") names the bundled
-// `dir`/<name>.json. Throws Error naming `path`, what it is not (`kind`: "scene", "robot") and
-// the bundled names, when there is none of that name.
+// `dir`/<name>.json; a relative path under "data/" that is not there names the same file of the
+// bundled data (`dir`'s parent), so that the docs' paths work from any folder. Throws Error naming
+// `path`, what it is not (`kind`: "scene", "robot") and the bundled names, when there is none of
+// that name.
 std::string resolve_bundled_file(const std::string& path, const std::string& dir,
                                  const std::string& kind);
 
