@@ -436,9 +436,9 @@ TEST(Planners, StartOrGoalOutsideTheCoverageFailsWithAReason) {
       EXPECT_TRUE(contains(r.failure, "bundle")) << "failure: " << r.failure;
       EXPECT_TRUE(contains(r.failure, start_is_far ? "start" : "goal")) << "failure: " << r.failure;
       EXPECT_FALSE(contains(r.failure, "time budget")) << "failure: " << r.failure;
-      // What puts it out of reach: a joint outside the region, or the nearest edge's distance.
-      EXPECT_TRUE(contains(r.failure, "the bundle's region [") ||
-                  contains(r.failure, start_is_far ? "nearest edge start is" : "nearest edge"))
+      // How far it is from the bundle: the nearest edge start (end, for the goal).
+      EXPECT_TRUE(contains(
+          r.failure, start_is_far ? "; the nearest edge start is " : "; the nearest edge end is "))
           << "failure: " << r.failure;
     }
   }
@@ -452,6 +452,7 @@ TEST(Planners, StartOrGoalOutsideTheCoverageFailsWithAReason) {
   EXPECT_FALSE(r.success);
   EXPECT_TRUE(contains(r.failure, "joint 2 (panda_joint2) is ")) << r.failure;
   EXPECT_TRUE(contains(r.failure, "the bundle's region [")) << r.failure;
+  EXPECT_TRUE(contains(r.failure, "; the nearest edge start is ")) << r.failure;
 }
 
 TEST(Planners, ALazyChainWithoutProgressEnds) {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <string>
 
 namespace lazyboe {
@@ -10,36 +11,52 @@ namespace {
 
 JointVector row(const double* p, int n) { return Eigen::Map<const Eigen::VectorXd>(p, n); }
 
-// What puts q out of the bundle's reach, for a coverage failure: the joints outside the bundle's
-// sampling region, or else how far the nearest edge start (end, for `ends`) lies.
-std::string coverage_hint(const PlanningContext& ctx, const JointVectorRef& q, bool ends) {
-  std::string hint;
+// The joints of q outside the bundle's sampling region, with their values and bounds; empty
+// when q lies inside it.
+std::string joints_outside_region(const PlanningContext& ctx, const JointVectorRef& q) {
+  std::string text;
   const JointVector& lo = ctx.sample_lower;
   const JointVector& hi = ctx.sample_upper;
   for (int i = 0; i < q.size() && lo.size() == q.size() && hi.size() == q.size(); ++i) {
     if (q[i] >= lo[i] && q[i] <= hi[i]) continue;
-    char text[160];
-    std::snprintf(text, sizeof text, "%sjoint %d (%s) is %.3f, the bundle's region [%.3f, %.3f]",
-                  hint.empty() ? "" : "; ", i + 1, ctx.sim.robot.joints[i].name.c_str(), q[i],
+    char joint[160];
+    std::snprintf(joint, sizeof joint, "%sjoint %d (%s) is %.3f, the bundle's region [%.3f, %.3f]",
+                  text.empty() ? "" : "; ", i + 1, ctx.sim.robot.joints[i].name.c_str(), q[i],
                   lo[i], hi[i]);
-    hint += text;
+    text += joint;
   }
-  if (!hint.empty()) return hint;
+  return text;
+}
+
+// The distance from q to the nearest edge start (end, for `ends`): by the index, widening the
+// radius, or by a scan of the ends without an end index; infinity when there is none.
+double nearest_edge(const PlanningContext& ctx, const JointVectorRef& q, bool ends) {
   const EdgeIndex* index = ends ? ctx.end_index : ctx.index;
-  if (!index) return "inside the bundle's region, but no edge is near";
-  std::vector<std::pair<uint32_t, double>> found;
-  for (double radius = std::max(ctx.theta, 0.05); radius < 64; radius *= 2) {
-    index->within(q.data(), radius, found);
-    if (found.empty()) continue;
-    double nearest = found.front().second;
-    for (const auto& f : found) nearest = std::min(nearest, f.second);
-    char text[120];
-    std::snprintf(text, sizeof text,
-                  "inside the bundle's region; the nearest edge %s is %.3f rad away",
-                  ends ? "end" : "start", std::sqrt(nearest));
-    return text;
+  double nearest = std::numeric_limits<double>::infinity();
+  if (!index) {  // no end index: every end state, as edge_ends_near does
+    const int n = ctx.bundle->dof();
+    for (size_t e = 0; e < ctx.bundle->size(); ++e)
+      nearest = std::min(nearest, (row(ctx.bundle->qf(e), n) - q).squaredNorm());
+    return std::sqrt(nearest);
   }
-  return "inside the bundle's region, but no edge is near";
+  std::vector<std::pair<uint32_t, double>> found;
+  for (double radius = std::max(ctx.theta, 0.05); found.empty() && radius < 64; radius *= 2)
+    index->within(q.data(), radius, found);
+  for (const auto& f : found) nearest = std::min(nearest, f.second);
+  return std::sqrt(nearest);
+}
+
+// What puts q out of the bundle's reach, for a coverage failure: the joints outside the bundle's
+// sampling region, and how far the nearest edge start (end, for `ends`) lies.
+std::string coverage_hint(const PlanningContext& ctx, const JointVectorRef& q, bool ends) {
+  const std::string outside = joints_outside_region(ctx, q);
+  const double nearest = nearest_edge(ctx, q, ends);
+  char text[120] = "";
+  if (std::isfinite(nearest)) {
+    std::snprintf(text, sizeof text, "; the nearest edge %s is %.3f rad away",
+                  ends ? "end" : "start", nearest);
+  }
+  return (outside.empty() ? "inside the bundle's region" : outside) + text;
 }
 
 }  // namespace
@@ -148,7 +165,7 @@ bool BundleSearch::covered(Neighbours& neighbours) {
   if (edge_ends_near(ctx_, goal.q, reach, neighbours)) return true;
   s_.result().failure = "no bundle edge ends within theta + tolerance = " + std::to_string(reach) +
                         " rad of the goal: it is outside the bundle's coverage (" +
-                        coverage_hint(ctx_, goal.q, ctx_.end_index != nullptr) +
+                        coverage_hint(ctx_, goal.q, true) +
                         "); try lazysp, a larger theta or tolerance, or a bundle built with a "
                         "--region that holds the goal";
   return false;
