@@ -4,7 +4,7 @@ BUILD_DIR ?= build
 JOBS ?= $(shell nproc)
 PREFIX ?= /usr/local
 
-.PHONY: all deps build test test-sanitize test-tsan fuzz demo bench install format clean
+.PHONY: all deps build test test-sanitize test-tsan fuzz demo demo-ur5 bench install format clean
 
 all: build
 
@@ -74,11 +74,21 @@ fuzz:
 	scripts/run-fuzz.sh $(FUZZ_BUILD_DIR) $(FUZZ_SECONDS) $(FUZZ_RUNS) $(FUZZ_TARGETS)
 
 # The build's output is kept in $(BUILD_DIR).build.log and shown only when it fails.
-demo: deps
+# The demos' build: its output in $(BUILD_DIR).build.log, shown only when it fails.
+define quiet_build
 	@cmake -S . -B $(BUILD_DIR) -DCMAKE_BUILD_TYPE=Release > $(BUILD_DIR).cmake.log 2>&1 || (cat $(BUILD_DIR).cmake.log; exit 1)
 	@echo "Building (output in $(BUILD_DIR).build.log) ..."
 	@cmake --build $(BUILD_DIR) -j$(JOBS) > $(BUILD_DIR).build.log 2>&1 || (cat $(BUILD_DIR).build.log; exit 1)
+endef
+
+demo: deps
+	$(quiet_build)
 	@scripts/demo.sh $(BUILD_DIR)
+
+# The second robot: the UR5 from its URDF to a viewer page (issue 28).
+demo-ur5: deps
+	$(quiet_build)
+	@scripts/demo-ur5.sh $(BUILD_DIR)
 
 install: build
 	cmake --install $(BUILD_DIR) --prefix $(PREFIX)

@@ -3,7 +3,10 @@
 configurations of a sub-box of the sampling region, checked with `lazyboe-robot check`.
 
 usage: make-queries.py OUT.jsonl COUNT SEED [--env FILE] [--tolerance T] [--planners a,b]
-                      [--box central|region] [--robot FILE] [--blocked] [--min-separation R]
+                      [--box central|region] [--robot FILE] [--region lo:hi,...]
+                      [--clearance M] [--blocked] [--min-separation R]
+
+Any robot (its dof and sampling region from `lazyboe-robot info --json`).
 
 --blocked keeps only pairs whose straight joint-space line collides in the scene (checked at
 every 0.02 rad with lazyboe-robot check): problems a single straight command cannot solve. It
@@ -25,20 +28,32 @@ p.add_argument("--blocked", action="store_true",
 p.add_argument("--min-separation", type=float, default=0.0,
                help="smallest joint-space distance between start and goal, rad")
 p.add_argument("--box", choices=["central", "region"], default="central",
-               help="central: the middle of the Panda's region, where a small demo bundle is "
-               "dense enough; region: the robot config's whole sampling region")
+               help="central: the middle 60%% of the robot's sampling region (the Panda's "
+               "table-top box, or another robot's joint range), where a small demo bundle is "
+               "dense enough; region: the whole sampling region")
+p.add_argument("--region", help="the bundle's region when it was built with lazyboe-build "
+               "--region lo:hi,lo:hi,... (the same text); default: the robot config's")
+p.add_argument("--clearance", type=float, default=0.03,
+               help="smallest distance of a start or goal to any obstacle or other link, m")
 a = p.parse_args()
-if a.box == "central":
-    lo = [-0.6, -0.1, -0.35, -2.35, -0.35, 1.55, 0.35]
-    hi = [0.6, 0.5, 0.35, -1.65, 0.35, 2.25, 1.25]
-else:
-    region = json.load(open(a.robot))["sampling_region"]
-    lo, hi = region["lower"], region["upper"]
+# Any robot: its sampling region as the tools read it (the config's, else the joint limits).
+info = json.loads(subprocess.run([a.tool, "--robot", a.robot, "info", "--json"], check=True,
+                                 capture_output=True, text=True).stdout)
+lo, hi = info["sampling_region"]["lower"], info["sampling_region"]["upper"]
+if a.region:
+    bounds = [b.split(":") for b in a.region.split(",")]
+    if len(bounds) != info["dof"] or any(len(b) != 2 for b in bounds):
+        sys.exit(f"make-queries: --region: expected {info['dof']} lo:hi pairs, one per joint")
+    lo, hi = [float(b[0]) for b in bounds], [float(b[1]) for b in bounds]
+if a.box == "central":  # rounded inwards to 0.05 rad (for the Panda: its former fixed box)
+    lo, hi = ([round(math.ceil((l + 0.2 * (h - l)) / 0.05 - 1e-9) * 0.05, 4) for l, h in zip(lo, hi)],
+              [round(math.floor((h - 0.2 * (h - l)) / 0.05 + 1e-9) * 0.05, 4) for l, h in zip(lo, hi)])
 rng = random.Random(a.seed)
 
 
-def check(configs, clearance=0.03):
+def check(configs, clearance=None):
     """lazyboe-robot check of each configuration: True where it is free (with `clearance`, m)."""
+    clearance = a.clearance if clearance is None else clearance
     with tempfile.TemporaryDirectory() as d:
         inp, res = os.path.join(d, "in.csv"), os.path.join(d, "out.csv")
         with open(inp, "w") as f:

@@ -18,8 +18,11 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <functional>
+#include <iterator>
 #include <map>
+#include <regex>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -778,6 +781,39 @@ TEST(BuildCli, ProgressIsPlainLinesWithASummary) {
   for (const auto& [reason, count] : h.rejected) {
     EXPECT_EQ(reported[reason], std::to_string(count)) << "rejected " << reason << "\n" << r.err;
   }
+}
+
+// The progress line names the leading rejection reason as the build goes.
+TEST(BuildCli, ProgressNamesTheTopRejection) {
+  const std::string dir = fresh_dir("progress-top");
+  const CommandResult r = build_tool({"--out", dir + "/b.h5", "--edges", "300", "--seed", "5"});
+  ASSERT_EQ(r.exit_code, 0) << describe(r);
+  EXPECT_TRUE(contains(r.err, "300/300 (100.0%) valid ")) << r.err;
+  EXPECT_TRUE(contains(r.err, ", top rejection ")) << r.err;
+}
+
+// A robot whose every motion is rejected (here torque-rate limits of 1 N m/s) stops after the
+// first 2000 attempts with the leading reasons and what to change, not after hours; the
+// partial bundle stays valid.
+TEST(BuildCli, AHopelessBuildStopsEarlyWithTheReason) {
+  const std::string dir = fresh_dir("hopeless");
+  std::ifstream in(source_path("data/robots/panda.json"));
+  const std::string config((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string slow = std::regex_replace(config, std::regex(R"("max_torque_rate": [0-9.]+)"),
+                                              R"("max_torque_rate": 1)");
+  ASSERT_NE(slow, config);
+  write_bytes(dir + "/slow.json", slow);
+  std::filesystem::copy_file(source_path("data/robots/panda.urdf"), dir + "/panda.urdf");
+  const std::string out = dir + "/b.h5";
+  const CommandResult r =
+      build_tool({"--robot", dir + "/slow.json", "--out", out, "--edges", "100", "--quiet"});
+  EXPECT_EQ(r.exit_code, 1) << describe(r);
+  expect_one_line_error(
+      r, {out, "stopped after the first 2000 attempts: 0 of 2000 attempts valid",
+          "most rejected: torque_rate_limit 100.0%", "max_torque_rate", "--keep-going"});
+  const Bundle b = read_bundle(out);
+  EXPECT_FALSE(b.header.complete);
+  EXPECT_EQ(b.header.attempts, 2000u);
 }
 
 TEST(BuildCli, QuietPrintsNothing) {

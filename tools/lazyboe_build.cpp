@@ -96,7 +96,7 @@ struct BuildOptions {
   BuildControl control;
   double sample_interval = 0.05;
   double workspace_cell = WorkspaceIndexOptions().cell;
-  bool resume = false, force = false, mpi = false;
+  bool resume = false, force = false, mpi = false, keep_going = false;
 };
 
 bool g_job_sent = false;  // MPI: rank 0 has sent the other ranks their job
@@ -153,6 +153,9 @@ void add_options(CLI::App& app, BuildOptions& o) {
   app.add_flag("--resume", o.resume, "Continue an interrupted build in --out (to --edges)");
   app.add_flag("--force", o.force, "Overwrite an existing --out");
   app.add_flag("--quiet", o.control.quiet, "No progress output");
+  app.add_flag("--keep-going", o.keep_going,
+               "Build even when almost every attempt is rejected (by default a build stops when "
+               "fewer than 2% of its first 2000 attempts are valid, saying why)");
   app.add_flag("--mpi", o.mpi,
                "Require MPI (run under mpirun or srun; without this flag MPI is used whenever "
                "the tool is launched by one)");
@@ -310,6 +313,7 @@ int grow_bundle(const Simulator& sim, BuildOptions& o, Bundle& bundle,
                 BuildCheckpoints& checkpoints) {
   install_stop_handlers();
   o.control.stop_requested = stop_requested;
+  o.control.stop_when_hopeless = !o.keep_going;
   o.control.save_progress = [&](const Bundle& b, bool last) {
     if (last) {
       checkpoints.finish(b);
@@ -336,6 +340,12 @@ int grow_bundle(const Simulator& sim, BuildOptions& o, Bundle& bundle,
   if (!o.control.quiet) {
     print_summary(bundle);
     print_checkpoint_stats(stats, bundle.header.wall_seconds, stderr);
+  }
+  if (outcome == BuildOutcome::Hopeless) {
+    fail(o.out_path, "stopped after the first " + std::to_string(kHopelessAttempts) +
+                         " attempts: " + rejection_diagnosis(bundle.header) +
+                         " (the partial bundle is kept; --resume continues it as it is, "
+                         "--keep-going builds anyway)");
   }
   if (outcome == BuildOutcome::Interrupted) {
     std::fprintf(stderr,

@@ -115,6 +115,9 @@ int cmd_info(const RobotModel& robot, bool as_json) {
     j["dof"] = robot.dof;
     j["gravity"] = vec_json(robot.gravity);
     j["control_rate"] = robot.control_rate;
+    j["tip_link"] = robot.links[robot.tip_link()].name;
+    j["sampling_region"] = {{"lower", vec_json(robot.region_lower)},
+                            {"upper", vec_json(robot.region_upper)}};
     for (const Joint& jt : robot.joints) {
       j["joints"].push_back({{"name", jt.name},
                              {"type", joint_type_name(jt)},
@@ -331,8 +334,9 @@ int cmd_validate_trajectory(const RobotModel& bundle_robot, const std::string& e
   const RobotModel robot = with_payload(bundle_robot, payload);
   // A trajectory checked against another scene than its own says nothing: no default.
   if (env_path.empty())
-    fail("--env", "name the scene the trajectory was planned in (an environment file, or a "
-                  "bundled scene: table, shelf, empty)");
+    fail("--env",
+         "name the scene the trajectory was planned in (an environment file, or a "
+         "bundled scene: table, shelf, empty)");
   const Environment env = load_environment(env_path);
   const CollisionModel cm = build_collision_model(robot, env);
   const TrajectoryCsv traj = read_trajectory_csv(in, robot.dof);
@@ -440,7 +444,7 @@ int main(int argc, char** argv) {
   auto* fk = app.add_subcommand("fk", "Pose of a link in the base frame, as JSON");
   std::string q_text, link_name;
   fk->add_option("--q", q_text, "Joint positions q1,...,qn")->required();
-  fk->add_option("--link", link_name, "Link name (default: the last link of the chain)");
+  fk->add_option("--link", link_name, "Link name (default: the tip link, the end of the chain)");
 
   auto* torques = app.add_subcommand("torques", "Inverse dynamics with friction for logged states");
   std::string in_path, out_path;

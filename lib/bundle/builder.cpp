@@ -58,6 +58,40 @@ std::string percent(uint64_t part, uint64_t whole) {
   return buf;
 }
 
+// The most frequent rejection reason and its count (empty when nothing was rejected).
+std::pair<std::string, uint64_t> top_rejection(const BundleHeader& h) {
+  std::pair<std::string, uint64_t> top;
+  for (const auto& [reason, count] : h.rejected)
+    if (count > top.second) top = {reason, count};
+  return top;
+}
+
+// What to change when most attempts fail for `reason`.
+const char* rejection_advice(const std::string& reason) {
+  if (reason == "env_collision")
+    return "The arm hits the scene: a base that touches the floor needs \"allowed_links\": "
+           "[\"@base\"] in the environment, or choose a region clear of the obstacles "
+           "(--region)";
+  if (reason == "self_collision" || reason == "start_in_collision")
+    return "The links touch each other or the scene at the starts: allowed pairs (lazyboe-robot "
+           "allowed-pairs), the collision margin, or a region away from contact (--region)";
+  if (reason == "torque_rate_limit")
+    return "The torques change faster than the config's max_torque_rate allows: lower gains, "
+           "a lower --limit-scale, or check the torque-rate limits (lazyboe-robot info)";
+  if (reason == "torque_limit")
+    return "The controller asks for more torque than the limits: lower gains, a lower "
+           "--limit-scale or --velocity-scale, or check the effort limits and masses "
+           "(lazyboe-robot info)";
+  if (reason == "position_limit")
+    return "The motions run into the joint limits: a region away from them (--region) or a "
+           "lower --velocity-scale";
+  if (reason == "not_settled")
+    return "The arm does not come to rest: the controller's gains cannot track (lazyboe-robot "
+           "init checks a step on every joint)";
+  return "The controller overshoots the limits: a lower --velocity-scale or --limit-scale, or "
+         "check the config's limits (lazyboe-robot info)";
+}
+
 }  // namespace
 
 void generate_edge(const Simulator& sim, SimulatorWorkspace& ws, const BuildSettings& settings,
@@ -215,7 +249,12 @@ BuildOutcome build_bundle(const Simulator& sim, const BuildSettings& settings, B
     last = true;
     checkpoints.save_now();
   };
-  auto status_line = [&]() { return "valid " + percent(h.valid, h.attempts); };
+  auto status_line = [&]() {
+    const auto [reason, count] = top_rejection(h);
+    return "valid " + percent(h.valid, h.attempts) +
+           (count ? ", top rejection " + reason + " " + percent(count, h.attempts) : "");
+  };
+  const bool check_hopeless = control.stop_when_hopeless && h.attempts < kHopelessAttempts;
 
   progress.update(bundle.size(), status_line());
   if (control.progress) control.progress(bundle.size(), settings.edges);
@@ -244,6 +283,13 @@ BuildOutcome build_bundle(const Simulator& sim, const BuildSettings& settings, B
       } else {
         ++h.rejected[e.reason()];
       }
+      if (check_hopeless && h.attempts == kHopelessAttempts &&
+          h.valid < kHopelessValidShare * kHopelessAttempts) {
+        progress.finish();
+        save(false);
+        if (control.stats) *control.stats = checkpoints.stats();
+        return BuildOutcome::Hopeless;
+      }
     }
     progress.update(bundle.size(), status_line());
     if (control.progress) control.progress(bundle.size(), settings.edges);
@@ -253,6 +299,22 @@ BuildOutcome build_bundle(const Simulator& sim, const BuildSettings& settings, B
   save(true);
   if (control.stats) *control.stats = checkpoints.stats();
   return BuildOutcome::Complete;
+}
+
+std::string rejection_diagnosis(const BundleHeader& h) {
+  std::vector<std::pair<uint64_t, std::string>> reasons;
+  for (const auto& [reason, count] : h.rejected) reasons.emplace_back(count, reason);
+  std::sort(reasons.begin(), reasons.end(), [](const auto& a, const auto& b) {
+    return a.first != b.first ? a.first > b.first : a.second < b.second;
+  });
+  std::string text = std::to_string(h.valid) + " of " + std::to_string(h.attempts) +
+                     " attempts valid (" + percent(h.valid, h.attempts) + ")";
+  for (size_t k = 0; k < reasons.size() && k < 3; ++k) {
+    text += (k == 0 ? "; most rejected: " : ", ") + reasons[k].second + " " +
+            percent(reasons[k].first, h.attempts);
+  }
+  if (!reasons.empty()) text += std::string(". ") + rejection_advice(reasons.front().second);
+  return text;
 }
 
 }  // namespace lazyboe

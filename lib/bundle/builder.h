@@ -34,7 +34,10 @@ struct BuildControl {
   int threads = 0;                 // 0: all available
   double checkpoint_seconds = 10;  // at least this long between checkpoints
   bool quiet = false;
-  std::function<bool()> stop_requested;                // polled between rounds
+  // Stop a build whose first kHopelessAttempts attempts are almost all rejected
+  // (BuildOutcome::Hopeless): a robot config or region that cannot work, said at once.
+  bool stop_when_hopeless = true;
+  std::function<bool()> stop_requested;  // polled between rounds
   // Persists the bundle so far (unset: nothing is saved); `last` is true for the run's last
   // save (complete, or interrupted), so that checkpoints can be incremental
   // (checkpoint_journal.h).
@@ -79,10 +82,19 @@ void check_resume_compatible(const BundleHeader& existing, const BundleHeader& w
 // Fails (naming the region) when no collision-free start can be found in it.
 void check_region(const Simulator& sim, const BuildSettings& settings);
 
-enum class BuildOutcome { Complete, Interrupted };
+// A build is hopeless when fewer than kHopelessValidShare of its first kHopelessAttempts
+// attempts are valid (checked once, at that attempt: the same for any thread count).
+constexpr uint64_t kHopelessAttempts = 2000;
+constexpr double kHopelessValidShare = 0.02;
+
+enum class BuildOutcome { Complete, Interrupted, Hopeless };
+
+// Why a build's attempts fail: the leading rejection reasons with their shares of the attempts
+// and what to change for the first, in one line.
+std::string rejection_diagnosis(const BundleHeader& h);
 
 // Grows `bundle` to settings.edges valid edges. Saves checkpoints as it goes and a last one
-// at the end (complete) or on interruption (incomplete).
+// at the end (complete) or on interruption or a hopeless start (incomplete).
 BuildOutcome build_bundle(const Simulator& sim, const BuildSettings& settings, Bundle& bundle,
                           const BuildControl& control);
 

@@ -217,7 +217,14 @@ py::object build(const py::object& out_arg, const py::object& robot_arg, const p
   control.save_progress = [&](const Bundle& b, bool last) {
     last ? checkpoints.finish(b) : checkpoints.save(b);
   };
-  run_job(py_control, [&] { build_bundle(sim, s, bundle, control); });
+  BuildOutcome outcome = BuildOutcome::Complete;
+  run_job(py_control, [&] { outcome = build_bundle(sim, s, bundle, control); });
+  if (outcome == BuildOutcome::Hopeless) {
+    throw std::runtime_error(out + ": stopped after the first " +
+                             std::to_string(kHopelessAttempts) +
+                             " attempts: " + rejection_diagnosis(bundle.header) +
+                             " (the partial bundle is kept; resume=True continues it as it is)");
+  }
   write_index_or_warn(out);
   return open_bundle(out);
 }

@@ -1,6 +1,7 @@
 """build_bundle / perturb_bundle: the tools' bundles, a progress callback, and a clean stop
 (Ctrl-C or an exception in the callback) that leaves a resumable file."""
 
+import json
 import pathlib
 import signal
 import subprocess
@@ -151,3 +152,21 @@ def test_sigint_from_outside_stops_a_build(tmp_path, bundle_path):
     done = int(rest.split()[-2]) if len(rest.split()) > 1 else 0
     b = lazyboe.build_bundle(out, resume=True, edges=max(done, 1) + 64)
     assert len(b) == max(done, 1) + 64
+
+
+def test_a_hopeless_build_stops_early_with_the_reason(tmp_path):
+    # Torque-rate limits of 1 N m/s reject every motion: the build stops after 2000 attempts
+    # with the reason and what to change, and the partial bundle stays readable.
+    source = pathlib.Path(lazyboe.data_dir()) / "robots"
+    config = json.loads((source / "panda.json").read_text())
+    for joint in config["joints"]:
+        joint["max_torque_rate"] = 1
+    config["urdf"] = str(source / "panda.urdf")
+    robot = tmp_path / "slow.json"
+    robot.write_text(json.dumps(config))
+    out = tmp_path / "b.h5"
+    with pytest.raises(RuntimeError, match="stopped after the first 2000 attempts") as e:
+        lazyboe.build_bundle(out, edges=100, robot=robot)
+    assert "torque_rate_limit 100.0%" in str(e.value) and "resume=True" in str(e.value)
+    with pytest.raises(OSError, match=r"incomplete bundle \(0 of 100 edges\)"):
+        lazyboe.Bundle(out)  # a valid file that says what it is
