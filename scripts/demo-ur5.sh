@@ -16,7 +16,7 @@ echo "== 1. Robot config from the URDF: lazyboe-robot init on data/robots/ur5/ur
 echo "   (limits from the URDF, documented defaults for the rest, gains computed from the model"
 echo "    and checked by a step on every joint, allowed pairs by sampling: no hand edits)"
 "$bin/lazyboe-robot" init --urdf data/robots/ur5/ur5.urdf --package-path data/robots/ur5 \
-  --tip-link tool0 --name ur5 --exact-links upper_arm_link --out "$out/ur5.json" 2>&1 |
+  --tip-link tool0 --name ur5 --convex-links upper_arm_link --out "$out/ur5.json" 2>&1 |
   tail -n 4 | sed 's/^/   /'
 "$bin/lazyboe-robot" --robot "$out/ur5.json" info | sed -n '1,4p'
 printf '   tool at the table-top pose: '

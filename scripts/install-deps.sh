@@ -7,8 +7,9 @@ packages=(
   build-essential cmake pkg-config
   libeigen3-dev libfcl-dev liburdfdom-dev libtinyxml-dev libhdf5-dev libcli11-dev
   nlohmann-json3-dev
-  # Obstacles given as meshes and point clouds (Assimp) and as OctoMap octrees (issue 26).
-  libassimp-dev liboctomap-dev
+  # Obstacles given as meshes and point clouds (Assimp) and as OctoMap octrees (issue 26);
+  # convex hulls of robot link meshes (Qhull, issue 28).
+  libassimp-dev liboctomap-dev libqhull-dev
   # The k-d tree over the bundle's edge end poses, pose goals' coverage (issue 29).
   libnanoflann-dev
   libgtest-dev libgmock-dev libbenchmark-dev

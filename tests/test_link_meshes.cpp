@@ -4,14 +4,17 @@
 // collides as the box primitive does; every bad mesh is one error naming the file and the link.
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
 #include <cstdlib>
 #include <filesystem>
+#include <map>
 #include <random>
 #include <string>
 
 #include "box_files.h"
 #include "lazyboe/bundle/scene.h"
 #include "lazyboe/collision/collision_model.h"
+#include "lazyboe/collision/convex_hull.h"
 #include "lazyboe/collision/environment.h"
 #include "lazyboe/common/error.h"
 #include "lazyboe/robot/kinematics.h"
@@ -200,6 +203,70 @@ TEST(LinkMeshes, ABoxAsAMeshCollidesAsTheBoxPrimitive) {
     EXPECT_GT(hits, 50);
     EXPECT_LT(hits, 2950);
   }
+}
+
+// The convex representation: the hull of a box mesh is the box, so it collides as the exact
+// mesh does and as the box primitive at most (which the margin grows as a box); `info`'s shape.
+TEST(LinkMeshes, ABoxAsAConvexHullCollidesAsTheExactMesh) {
+  const std::string kConvex = R"(, "meshes": {"representation": "convex"})";
+  for (double margin : {0.0, 0.01}) {
+    const RobotModel box = load("box", kBoxUrdf, config("box.urdf", "", margin));
+    const RobotModel exact =
+        load("exact", kMeshUrdf, config("exact.urdf", kPackagePath, margin, kExact));
+    const RobotModel hull =
+        load("hull", kMeshUrdf, config("hull.urdf", kPackagePath, margin, kConvex));
+    for (const CollisionBody& b : hull.collision_bodies) {
+      EXPECT_TRUE(b.shape.type == ShapeType::Mesh && b.shape.convex) << b.name;
+      EXPECT_EQ(b.shape.mesh->vertices.size(), 8u) << b.name;  // a box's corners
+      EXPECT_EQ(b.representation, MeshRepresentation::Convex);
+    }
+    const std::vector<Outcome> b = sweep(box, 3000), e = sweep(exact, 3000), h = sweep(hull, 3000);
+    int hits = 0;
+    for (size_t k = 0; k < b.size(); ++k) {
+      EXPECT_NEAR(h[k].distance, b[k].distance, 1e-6) << "configuration " << k;
+      EXPECT_EQ(h[k].hit, e[k].hit) << "configuration " << k;
+      if (h[k].hit) {
+        EXPECT_TRUE(b[k].hit) << "configuration " << k;
+      }
+      hits += h[k].hit;
+    }
+    EXPECT_GT(hits, 50);
+    EXPECT_LT(hits, 2950);
+  }
+}
+
+// Qhull's hull of a non-convex mesh (two boxes in an L, and points inside): a closed surface
+// of outward triangles that encloses every vertex, made of the outer corners only.
+TEST(LinkMeshes, TheConvexHullEnclosesEveryVertexWithOutwardTriangles) {
+  TriangleMesh l;
+  for (const Eigen::Vector3d& corner : {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(0.3, 0, 0),
+                                        Eigen::Vector3d(0, 0.1, 0), Eigen::Vector3d(0.3, 0.1, 0)}) {
+    for (double z : {0.0, 0.1}) l.vertices.push_back(corner + Eigen::Vector3d(0, 0, z));
+  }
+  for (const Eigen::Vector3d& corner : {Eigen::Vector3d(0, 0.1, 0), Eigen::Vector3d(0.1, 0.1, 0),
+                                        Eigen::Vector3d(0, 0.4, 0), Eigen::Vector3d(0.1, 0.4, 0)}) {
+    for (double z : {0.0, 0.1}) l.vertices.push_back(corner + Eigen::Vector3d(0, 0, z));
+  }
+  l.vertices.push_back({0.05, 0.05, 0.05});  // inside
+  l.vertices.push_back({0.05, 0.2, 0.05});   // inside
+  const TriangleMesh hull = convex_hull(l, "l.stl");
+  EXPECT_EQ(hull.vertices.size(), 10u);  // the L's 5 outer corners in plan, top and bottom
+  std::map<std::pair<int, int>, int> edges;
+  double volume = 0;
+  for (const Eigen::Vector3i& t : hull.triangles) {
+    const Eigen::Vector3d &a = hull.vertices[t[0]], &b = hull.vertices[t[1]],
+                          &c = hull.vertices[t[2]];
+    const Eigen::Vector3d normal = (b - a).cross(c - a);
+    for (const Eigen::Vector3d& v : l.vertices) EXPECT_LE(normal.dot(v - a), 1e-12);
+    volume += a.dot(b.cross(c)) / 6;
+    for (int k = 0; k < 3; ++k) ++edges[{t[k], t[(k + 1) % 3]}];
+  }
+  for (const auto& [edge, count] : edges) {
+    EXPECT_EQ(count, 1);
+    EXPECT_EQ(edges.count({edge.second, edge.first}), 1u) << "an edge with one side";
+  }
+  EXPECT_GT(volume, 0.3 * 0.4 * 0.1 - 0.2 * 0.3 * 0.1);  // more than the L itself
+  EXPECT_THROW(convex_hull(TriangleMesh{{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, {}}, "t.stl"), Error);
 }
 
 TEST(LinkMeshes, PackagesResolveThroughRosPackagePathFileUrisAndRelativePaths) {

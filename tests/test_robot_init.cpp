@@ -16,7 +16,7 @@ namespace {
 
 const std::string kInit = " init --urdf " + test::source_path("data/robots/ur5/ur5.urdf") +
                           " --package-path " + test::source_path("data/robots/ur5") +
-                          " --tip-link tool0 --name ur5 --exact-links upper_arm_link";
+                          " --tip-link tool0 --name ur5 --convex-links upper_arm_link";
 
 TEST(RobotInit, WritesTheShippedUr5ConfigAndItsGainsTrackEveryJoint) {
   const std::string out = test::temp_dir() + "/ur5.json";

@@ -78,7 +78,8 @@ std::string shape_text(const Shape& s) {
       std::snprintf(buf, sizeof buf, "box %.4gx%.4gx%.4g", s.size.x(), s.size.y(), s.size.z());
       break;
     case ShapeType::Mesh:
-      std::snprintf(buf, sizeof buf, "mesh of %zu triangles", s.mesh->triangles.size());
+      std::snprintf(buf, sizeof buf, "%s of %zu triangles", s.convex ? "convex hull" : "mesh",
+                    s.mesh->triangles.size());
       break;
   }
   return buf;
@@ -89,7 +90,8 @@ std::string shape_text(const Shape& s) {
 std::string body_text(const CollisionBody& c) {
   std::string text = shape_text(c.shape);
   if (c.mesh_file.empty()) return text;
-  if (c.representation == MeshRepresentation::Exact) return text + " (exact: " + c.mesh_file + ")";
+  if (c.representation != MeshRepresentation::Fitted)
+    return text + " (" + mesh_representation_name(c.representation) + ": " + c.mesh_file + ")";
   char buf[64];
   std::snprintf(buf, sizeof buf, ", over-approximation %.1f mm)", 1000 * c.over_approximation);
   return text + " (fitted to " + c.mesh_file + buf;
@@ -375,8 +377,11 @@ int cmd_validate_trajectory(const RobotModel& bundle_robot, const std::string& e
 // Writes the config `init` makes, then says what it assumed and how the gains tracked.
 int cmd_init(RobotSetupOptions options, const std::string& package_path,
              const std::string& meshes) {
-  if (meshes != "fitted" && meshes != "exact") fail("--meshes", "expected fitted or exact");
-  options.meshes = meshes == "exact" ? MeshRepresentation::Exact : MeshRepresentation::Fitted;
+  if (meshes != "fitted" && meshes != "exact" && meshes != "convex")
+    fail("--meshes", "expected fitted, exact or convex");
+  options.meshes = meshes == "exact"    ? MeshRepresentation::Exact
+                   : meshes == "convex" ? MeshRepresentation::Convex
+                                        : MeshRepresentation::Fitted;
   options.package_path = split_path_list(package_path);
   refuse_output_as_input({"--out", options.out_path},
                          {{"--urdf", options.urdf_path}, {"--srdf", options.srdf_path}});
@@ -414,10 +419,15 @@ CLI::App* add_init_command(CLI::App& app, RobotSetupOptions& setup, std::string&
   init->add_option("--base-link", setup.base_link, "Root of the planned chain");
   init->add_option("--tip-link", setup.tip_link, "End of the planned chain (the tool flange)");
   init->add_option("--name", setup.name, "Robot name (default: the URDF's file name)");
-  init->add_option("--meshes", meshes, "Mesh links: fitted (capsules) or exact")
+  init->add_option("--meshes", meshes,
+                   "Mesh links: fitted (capsules), exact (the meshes) or convex (their hulls)")
       ->capture_default_str();
   init->add_option("--exact-links", setup.exact_links,
                    "Mesh links kept exact (comma-separated), whatever --meshes says")
+      ->delimiter(',');
+  init->add_option("--convex-links", setup.convex_links,
+                   "Mesh links checked as their convex hulls (comma-separated), whatever --meshes "
+                   "says")
       ->delimiter(',');
   init->add_option("--margin", setup.margin, "Collision margin, m")->capture_default_str();
   init->add_option("--samples", setup.pair_samples, "Configurations sampled for allowed pairs")

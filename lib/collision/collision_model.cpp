@@ -32,6 +32,17 @@ std::shared_ptr<fcl::BVHModel<fcl::OBBRSSd>> mesh_geometry(const TriangleMesh& m
 
 namespace {
 
+// A convex hull (convex_hull.h: a closed surface of outward triangles) as FCL's Convex, whose
+// support function GJK uses directly; the triangles give it its vertex neighbours.
+std::shared_ptr<fcl::Convexd> convex_geometry(const TriangleMesh& hull) {
+  auto vertices = std::make_shared<std::vector<Eigen::Vector3d>>(hull.vertices);
+  auto faces = std::make_shared<std::vector<int>>();
+  faces->reserve(4 * hull.triangles.size());
+  for (const Eigen::Vector3i& t : hull.triangles)
+    faces->insert(faces->end(), {3, t[0], t[1], t[2]});
+  return std::make_shared<fcl::Convexd>(vertices, static_cast<int>(hull.triangles.size()), faces);
+}
+
 // `inflate` grows a primitive by the margin; a mesh is not grown (its pairs compare distances).
 std::shared_ptr<fcl::CollisionGeometryd> make_geometry(const Shape& s, double inflate) {
   switch (s.type) {
@@ -44,6 +55,7 @@ std::shared_ptr<fcl::CollisionGeometryd> make_geometry(const Shape& s, double in
     case ShapeType::Box:
       return std::make_shared<fcl::Boxd>(s.size + Eigen::Vector3d::Constant(2 * inflate));
     case ShapeType::Mesh:
+      if (s.convex) return convex_geometry(*s.mesh);
       return mesh_geometry(*s.mesh);
   }
   return nullptr;
@@ -190,6 +202,23 @@ double narrow_distance(CollisionData& data, const fcl::CollisionGeometryd* g1,
   return fcl::distance(g1, t1, g2, t2, s.distance_request, s.distance_result) < margin;
 }
 
+inline bool is_convex(const fcl::CollisionGeometryd* g) {
+  return g->getNodeType() == fcl::GEOM_CONVEX;
+}
+
+// Two convex shapes, one of them a convex hull (no grown copy): their GJK distance against the
+// margin (negative when they overlap), or with no margin their intersection.
+[[gnu::noinline]] bool convex_pair_collides(const CollisionData& data, double margin,
+                                            const fcl::CollisionGeometryd* g1,
+                                            const fcl::Transform3d& t1,
+                                            const fcl::CollisionGeometryd* g2,
+                                            const fcl::Transform3d& t2) {
+  if (!(margin > 0)) return narrow_collide(g1, t1, g2, t2);
+  CollisionScratch& s = *data.scratch;
+  s.distance_result.clear();
+  return fcl::distance(g1, t1, g2, t2, s.distance_request, s.distance_result) < margin;
+}
+
 // Signed distance of two capsules by FCL's closed-form segment-segment routine: much cheaper
 // than the generic GJK path, and most robot shapes are capsules.
 double capsule_distance(const CollisionShapes& shapes, const CollisionData& data, int a, int b) {
@@ -207,7 +236,17 @@ bool self_collides(const CollisionShapes& shapes, const CollisionData& data, int
   const CollisionShapes::Robot& sa = shapes.robot[a];
   const CollisionShapes::Robot& sb = shapes.robot[b];
   if (shapes.capsule[a] && shapes.capsule[b]) return capsule_distance(shapes, data, a, b) < margin;
-  if (!sa.inflated || !sb.inflated)  // a mesh
+  // Hulls (no grown copy) against each other by distance, against a grown primitive by GJK.
+  const bool hull_a = !sa.inflated && is_convex(sa.exact);
+  const bool hull_b = !sb.inflated && is_convex(sb.exact);
+  if (hull_a && hull_b)
+    return convex_pair_collides(data, margin, sa.exact, data.transform[a], sb.exact,
+                                data.transform[b]);
+  if (hull_a && sb.inflated)
+    return narrow_collide(sb.inflated, data.transform[b], sa.exact, data.transform[a]);
+  if (hull_b && sa.inflated)
+    return narrow_collide(sa.inflated, data.transform[a], sb.exact, data.transform[b]);
+  if (!sa.inflated || !sb.inflated)  // a mesh (or a hull against a mesh)
     return mesh_pair_collides(data, margin, sa.exact, data.transform[a], sb.exact,
                               data.transform[b]);
   return narrow_collide(sa.inflated, data.transform[a], sb.exact, data.transform[b]);
@@ -217,6 +256,9 @@ bool env_collides(const CollisionShapes& shapes, const CollisionData& data, int 
   const CollisionShapes::Robot& robot = shapes.robot[a];
   const CollisionShapes::Obstacle& obstacle = shapes.obstacles[o];
   if (!sphere_may_touch_box(data.sphere_centre[a], shapes.env_radius[a], obstacle)) return false;
+  if (!robot.inflated && obstacle.primitive && is_convex(robot.exact))  // a hull
+    return convex_pair_collides(data, shapes.margin, robot.exact, data.transform[a],
+                                obstacle.geometry, obstacle.transform);
   if (!robot.inflated)  // a mesh
     return mesh_pair_collides(data, shapes.margin, robot.exact, data.transform[a],
                               obstacle.geometry, obstacle.transform);

@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "lazyboe/collision/convex_hull.h"
 #include "lazyboe/collision/mesh.h"
 #include "lazyboe/collision/mesh_fit.h"
 #include "lazyboe/common/error.h"
@@ -65,8 +66,10 @@ TriangleMesh read_link_mesh(const std::string& file, const urdf::Mesh& m,
   return mesh;
 }
 
-// A mesh element as a fitted capsule (or sphere), or as the mesh itself about its box centre.
-void set_mesh_shape(CollisionBody& body, TriangleMesh mesh, MeshRepresentation representation) {
+// A mesh element as a fitted capsule (or sphere), or as the mesh itself or its convex hull
+// about its box centre.
+void set_mesh_shape(CollisionBody& body, TriangleMesh mesh, MeshRepresentation representation,
+                    const std::string& where) {
   body.representation = representation;
   if (representation == MeshRepresentation::Fitted) {
     const FittedShape fitted = fit_enclosing_capsule(mesh);
@@ -74,6 +77,10 @@ void set_mesh_shape(CollisionBody& body, TriangleMesh mesh, MeshRepresentation r
     body.in_link = body.in_link * fitted.in_mesh;
     body.over_approximation = fitted.over_approximation;
     return;
+  }
+  if (representation == MeshRepresentation::Convex) {
+    mesh = convex_hull(mesh, where + ": " + body.mesh_file);
+    body.shape.convex = true;
   }
   Eigen::Vector3d lower, upper;
   mesh_bounds(mesh, lower, upper);
@@ -141,7 +148,8 @@ void add_link_collision_bodies(RobotModel& model, const urdf::Link& link, int li
     if (c.geometry->type == urdf::Geometry::MESH) {
       const auto& m = static_cast<const urdf::Mesh&>(*c.geometry);
       e.body.mesh_file = resolve_urdf_resource(m.filename, model.urdf_path, search, where);
-      set_mesh_shape(e.body, read_link_mesh(e.body.mesh_file, m, where), meshes.of(link.name));
+      set_mesh_shape(e.body, read_link_mesh(e.body.mesh_file, m, where), meshes.of(link.name),
+                     where);
       model.resource_files.push_back(e.body.mesh_file);
     } else {
       e.body.shape = primitive_shape(*c.geometry, where);

@@ -201,7 +201,15 @@ const char* shape_type_name(ShapeType type) {
 }
 
 const char* mesh_representation_name(MeshRepresentation representation) {
-  return representation == MeshRepresentation::Exact ? "exact" : "fitted";
+  switch (representation) {
+    case MeshRepresentation::Exact:
+      return "exact";
+    case MeshRepresentation::Convex:
+      return "convex";
+    case MeshRepresentation::Fitted:
+      break;
+  }
+  return "fitted";
 }
 
 int link_field(const JsonField& object, const RobotModel& robot) {
@@ -436,10 +444,12 @@ MeshRepresentation mesh_representation(const JsonField& field) {
   const std::string name = field.string();
   if (name == "fitted") return MeshRepresentation::Fitted;
   if (name == "exact") return MeshRepresentation::Exact;
-  field.fail("unknown mesh representation '" + name + "' (expected fitted or exact)");
+  if (name == "convex") return MeshRepresentation::Convex;
+  field.fail("unknown mesh representation '" + name + "' (expected fitted, exact or convex)");
 }
 
-// collision.meshes: {"representation": "fitted" | "exact", "links": {"<link>": "exact", ...}}.
+// collision.meshes: {"representation": "fitted" | "exact" | "convex", "links": {"<link>":
+// "exact", ...}}.
 MeshSettings read_mesh_settings(const RobotModel& model, const JsonField& collision) {
   MeshSettings settings;
   if (!collision.has("meshes")) return settings;

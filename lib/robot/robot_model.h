@@ -75,13 +75,15 @@ struct Shape {
   double length = 0;                               // cylinder, capsule: along local z
   Eigen::Vector3d size = Eigen::Vector3d::Zero();  // box: full extents
   std::shared_ptr<const TriangleMesh> mesh;        // mesh: triangles about the shape's frame
+  bool convex = false;  // mesh: a convex hull, checked as one convex shape (GJK), not a BVH
 };
 const char* shape_type_name(ShapeType type);
 
 // How a link whose URDF collision geometry is a mesh is checked: a capsule fitted around the
-// mesh (the fast primitive checks; conservative by its over-approximation) or the mesh itself
-// (FCL's bounding volume hierarchy: exact, slower).
-enum class MeshRepresentation { Fitted, Exact };
+// mesh (the fast primitive checks; conservative by its over-approximation), the mesh itself
+// (FCL's bounding volume hierarchy: exact, slower), or its convex hull (Qhull; one convex shape
+// for GJK: exact for a convex part, never less conservative than the mesh, and fast).
+enum class MeshRepresentation { Fitted, Exact, Convex };
 const char* mesh_representation_name(MeshRepresentation representation);
 
 struct CollisionBody {

@@ -63,6 +63,7 @@ json draft_config(const RobotSetupOptions& o, const std::string& base, const std
   for (const Joint& j : joints) config["joints"].push_back(joint_entry(j));
   json meshes = {{"representation", mesh_representation_name(o.meshes)}};
   for (const std::string& link : o.exact_links) meshes["links"][link] = "exact";
+  for (const std::string& link : o.convex_links) meshes["links"][link] = "convex";
   config["collision"] = {
       {"margin", o.margin}, {"meshes", meshes}, {"allowed_pairs", json::array()}};
   return config;

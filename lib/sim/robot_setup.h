@@ -28,11 +28,12 @@ struct RobotSetupOptions {
   std::string base_link, tip_link;        // empty: the SRDF's chain, else the URDF's defaults
   std::string name;                       // empty: the URDF file's name without extension
   MeshRepresentation meshes = MeshRepresentation::Fitted;
-  std::vector<std::string> exact_links;  // mesh links kept exact whatever `meshes` says
-  double margin = 0.01;                  // m
-  double time_constant = 0.05;           // velocity loop at the largest joint inertia, s
-  long pair_samples = 20000;             // configurations sampled for the allowed pairs
-  long inertia_samples = 1000;           // configurations sampled for the gains
+  std::vector<std::string> exact_links;   // mesh links kept exact whatever `meshes` says
+  std::vector<std::string> convex_links;  // mesh links checked as their convex hulls
+  double margin = 0.01;                   // m
+  double time_constant = 0.05;            // velocity loop at the largest joint inertia, s
+  long pair_samples = 20000;              // configurations sampled for the allowed pairs
+  long inertia_samples = 1000;            // configurations sampled for the gains
   uint64_t seed = 1;
   std::string out_path;  // where the config goes: its relative paths start from its folder
 };
