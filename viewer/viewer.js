@@ -256,11 +256,14 @@
                                                     depthWrite: !ghost, polygonOffset: ghost,
                                                     polygonOffsetFactor: 2, polygonOffsetUnits: 2});
     const group = new THREE.Group();
+    // A link whose URDF geometry is a mesh is drawn as that mesh (`display`), whatever stands
+    // for it in the collision checks (a fitted capsule, a convex hull); other shapes as they are.
     const parts = robot.shapes.map((s) => {
-      const o = shapeObject(s, material);
+      const shown = s.display ? Object.assign({type: 'mesh', name: s.name}, s.display) : s;
+      const o = shapeObject(shown, material);
       o.layers.set(layer);
       group.add(o);
-      return o;
+      return {object: o, pose: shown.pose};
     });
     robotLayer.add(group);
     let payload = null;  // {box: the mesh, link, at: its pose on the link}
@@ -271,7 +274,7 @@
         if (layer !== MOVING_LAYER) stillLayers.changed();
         lastQ = q;
         const poses = linkPoses(robot, q);
-        robot.shapes.forEach((s, i) => setMatrix(parts[i], compose(poses[s.link], s.pose)));
+        robot.shapes.forEach((s, i) => setMatrix(parts[i].object, compose(poses[s.link], parts[i].pose)));
         if (payload) setMatrix(payload.box, compose(poses[payload.link], payload.at));
       },
       // The query's payload as a box at its centre of mass on its link (default the tip), or
@@ -663,6 +666,7 @@
   };
   stillLayers.render();
   body.setAttribute('data-robot-shapes', String(robot.shapes.length));
+  body.setAttribute('data-robot-meshes', String(robot.shapes.filter((s) => s.display).length));
   body.setAttribute('data-obstacles', String(data.environment.obstacles.length));
   body.setAttribute('data-obstacle-types', data.environment.obstacles.map((o) => o.type).join(' '));
   body.setAttribute('data-trajectories', String(trajectories.length));

@@ -71,6 +71,10 @@ TriangleMesh read_link_mesh(const std::string& file, const urdf::Mesh& m,
 void set_mesh_shape(CollisionBody& body, TriangleMesh mesh, MeshRepresentation representation,
                     const std::string& where) {
   body.representation = representation;
+  if (representation != MeshRepresentation::Exact) {  // an exact shape is the mesh itself
+    body.source_mesh = std::make_shared<const TriangleMesh>(mesh);
+    body.source_in_link = body.in_link;
+  }
   if (representation == MeshRepresentation::Fitted) {
     const FittedShape fitted = fit_enclosing_capsule(mesh);
     body.shape = fitted.shape;

@@ -96,6 +96,10 @@ struct CollisionBody {
   std::string mesh_file;
   MeshRepresentation representation = MeshRepresentation::Fitted;
   double over_approximation = 0;
+  // A fitted or convex mesh link: the mesh as read (scaled) and its frame in the link, which the
+  // viewer draws, whatever stands for it in the checks.
+  std::shared_ptr<const TriangleMesh> source_mesh;
+  Pose source_in_link;
 };
 
 // Joint-level controller used to simulate the robot following joint-velocity commands: a

@@ -74,6 +74,10 @@ json robot_view_json(const RobotModel& robot) {
   for (const CollisionBody& b : robot.collision_bodies) {
     json s = shape_json(b.name, b.shape, b.in_link);
     s["link"] = b.link;
+    if (b.source_mesh) {  // drawn as its mesh; the shape checked stays in the data
+      s["display"] = {{"pose", pose_json(b.source_in_link)}};
+      add_triangles(*b.source_mesh, s["display"]);
+    }
     shapes.push_back(s);
   }
   return {{"name", robot.name},     {"config", robot.config_path},

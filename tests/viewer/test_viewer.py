@@ -271,6 +271,10 @@ def main():
     files_page = os.path.join(out_dir, "files.html")
     run([tool, "--results", results, "--queries", queries, "--env", files_scene, "--out", files_page])
     goals_page = task_page(bin_dir, out_dir)
+    ur5_home, ur5_other = [0, -1.57, 1.57, -1.57, -1.57, 0], [0.5, -1.2, 1.3, -1.8, -1.4, 0.4]
+    ur5_page = os.path.join(out_dir, "ur5.html")
+    run([tool, "--robot", "ur5", "--results", write_lines(os.path.join(out_dir, "ur5.jsonl"), [
+        trajectory_result("u", 1, ur5_home, ur5_other)]), "--out", ur5_page])
     no_trajectories = os.path.join(out_dir, "none.html")
     bare = trajectory_result("a", 1, READY, OTHER)
     del bare["trajectory"]
@@ -325,6 +329,11 @@ def main():
         nonblank_robot(browser, os.path.join(out_dir, "files.png"), "mesh and point-cloud page")
 
         check_task_page(browser, bin_dir, goals_page)
+
+        state = open_page(browser, ur5_page, "UR5 page")
+        check(state.get("robotMeshes") == "7" and state.get("robotShapes") == "8",
+              f"UR5 page: its 7 mesh links drawn as their meshes, the 8th shape as it is ({state})")
+        nonblank_robot(browser, os.path.join(out_dir, "ur5.png"), "UR5 page")
 
         state = open_page(browser, only_failed, "failed-only page")
         text = browser.evaluate("document.body.innerText")
