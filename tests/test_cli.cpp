@@ -166,6 +166,9 @@ TEST(Cli, InfoNamesJointsAndCollisionBodies) {
     EXPECT_NE(r.out.find(c.name), std::string::npos) << c.name << "\n" << r.out;
   }
   EXPECT_NE(r.out.find("collision bodies"), std::string::npos) << r.out;
+  // The gains and the sampling region the simulator and the builder use, per joint.
+  EXPECT_NE(r.out.find("tip link panda_link8; controller gains"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("region [-0.3, 0.7]"), std::string::npos) << r.out;  // panda_joint2's
 }
 
 TEST(Cli, InfoJsonParsesWithSevenDof) {
@@ -186,6 +189,9 @@ TEST(Cli, InfoJsonParsesWithSevenDof) {
   }
   EXPECT_DOUBLE_EQ(j["joints"][3].at("lower").get<double>(), -3.0718);
   EXPECT_DOUBLE_EQ(j["joints"][3].at("upper").get<double>(), -0.0698);
+  EXPECT_EQ(j.at("tip_link").get<std::string>(), "panda_link8");
+  EXPECT_EQ(j["sampling_region"]["lower"][1].get<double>(), panda().region_lower[1]);
+  EXPECT_EQ(j["controller"]["kv"].size(), 7u);
 }
 
 TEST(Cli, FkAtZeroIsTheFlangePose) {

@@ -107,50 +107,69 @@ json body_json(const RobotModel& robot, const CollisionBody& c) {
   return j;
 }
 
+// `info --json`: the model as the tools read it.
+json info_json(const RobotModel& robot, const CollisionModel& cm) {
+  json j;
+  j["name"] = robot.name;
+  j["config"] = robot.config_path;
+  j["urdf"] = robot.urdf_path;
+  j["dof"] = robot.dof;
+  j["gravity"] = vec_json(robot.gravity);
+  j["control_rate"] = robot.control_rate;
+  j["tip_link"] = robot.links[robot.tip_link()].name;
+  j["sampling_region"] = {{"lower", vec_json(robot.region_lower)},
+                          {"upper", vec_json(robot.region_upper)}};
+  for (const Joint& jt : robot.joints) {
+    j["joints"].push_back({{"name", jt.name},
+                           {"type", joint_type_name(jt)},
+                           {"lower", jt.lower},
+                           {"upper", jt.upper},
+                           {"max_velocity", jt.max_velocity},
+                           {"max_acceleration", jt.max_acceleration},
+                           {"max_jerk", jt.max_jerk},
+                           {"max_effort", jt.max_effort},
+                           {"max_torque_rate", jt.max_torque_rate},
+                           {"friction", friction_json(jt.friction)}});
+  }
+  for (size_t b = 0; b < robot.bodies.size(); ++b) {
+    j["bodies"].push_back({{"joint", robot.joints[b].name},
+                           {"mass", robot.bodies[b].mass},
+                           {"com", vec_json(robot.bodies[b].com)}});
+  }
+  for (const Link& l : robot.links) {
+    j["links"].push_back(
+        {{"name", l.name}, {"moved_by", l.body < 0 ? "base" : robot.joints[l.body].name}});
+  }
+  for (const CollisionBody& c : robot.collision_bodies) {
+    j["collision_bodies"].push_back(body_json(robot, c));
+  }
+  j["collision_margin"] = robot.collision_margin;
+  for (const auto& [a, b] : robot.allowed_pairs) {
+    j["allowed_pairs"].push_back({robot.links[a].name, robot.links[b].name});
+  }
+  j["self_pairs_tested"] = cm.self_pairs.size();
+  j["ignored_links"] = robot.ignored_links;
+  j["controller"] = {{"kv", vec_json(robot.controller.kv)},
+                     {"ka", vec_json(robot.controller.ka)},
+                     {"friction_feedforward", robot.controller.friction_feedforward}};
+  return j;
+}
+
+// The controller's gains and the sampling region, as the simulator and the builder use them.
+void print_controller_and_region(const RobotModel& robot) {
+  std::printf("\ntip link %s; controller gains per joint (kv N m s/rad, ka kg m^2)%s:\n",
+              robot.links[robot.tip_link()].name.c_str(),
+              robot.controller.friction_feedforward ? ", friction feed-forward" : "");
+  for (int i = 0; i < robot.dof && robot.controller.present; ++i)
+    std::printf("  %-20s kv %9.4g  ka %9.4g  region [%.4g, %.4g]\n", robot.joints[i].name.c_str(),
+                robot.controller.kv[i], robot.controller.ka[i], robot.region_lower[i],
+                robot.region_upper[i]);
+}
+
 int cmd_info(const RobotModel& robot, bool as_json) {
   const CollisionModel cm = build_collision_model(robot, Environment{});
   if (as_json) {
-    json j;
-    j["name"] = robot.name;
-    j["config"] = robot.config_path;
-    j["urdf"] = robot.urdf_path;
-    j["dof"] = robot.dof;
-    j["gravity"] = vec_json(robot.gravity);
-    j["control_rate"] = robot.control_rate;
-    j["tip_link"] = robot.links[robot.tip_link()].name;
-    j["sampling_region"] = {{"lower", vec_json(robot.region_lower)},
-                            {"upper", vec_json(robot.region_upper)}};
-    for (const Joint& jt : robot.joints) {
-      j["joints"].push_back({{"name", jt.name},
-                             {"type", joint_type_name(jt)},
-                             {"lower", jt.lower},
-                             {"upper", jt.upper},
-                             {"max_velocity", jt.max_velocity},
-                             {"max_acceleration", jt.max_acceleration},
-                             {"max_jerk", jt.max_jerk},
-                             {"max_effort", jt.max_effort},
-                             {"max_torque_rate", jt.max_torque_rate},
-                             {"friction", friction_json(jt.friction)}});
-    }
-    for (size_t b = 0; b < robot.bodies.size(); ++b) {
-      j["bodies"].push_back({{"joint", robot.joints[b].name},
-                             {"mass", robot.bodies[b].mass},
-                             {"com", vec_json(robot.bodies[b].com)}});
-    }
-    for (const Link& l : robot.links) {
-      j["links"].push_back(
-          {{"name", l.name}, {"moved_by", l.body < 0 ? "base" : robot.joints[l.body].name}});
-    }
-    for (const CollisionBody& c : robot.collision_bodies) {
-      j["collision_bodies"].push_back(body_json(robot, c));
-    }
-    j["collision_margin"] = robot.collision_margin;
-    for (const auto& [a, b] : robot.allowed_pairs) {
-      j["allowed_pairs"].push_back({robot.links[a].name, robot.links[b].name});
-    }
-    j["self_pairs_tested"] = cm.self_pairs.size();
-    j["ignored_links"] = robot.ignored_links;
-    std::cout << j.dump(2) << "\n";
+    std::cout << info_json(robot, cm).dump(2) << "\n";
     return 0;
   }
   std::printf("robot %s\n  config %s\n  urdf   %s\n", robot.name.c_str(), robot.config_path.c_str(),
@@ -186,6 +205,7 @@ int cmd_info(const RobotModel& robot, bool as_json) {
   }
   std::printf("allowed-collision link pairs: %zu; body pairs tested for self-collision: %zu\n",
               robot.allowed_pairs.size(), cm.self_pairs.size());
+  print_controller_and_region(robot);
   return 0;
 }
 
