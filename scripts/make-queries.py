@@ -46,8 +46,11 @@ if a.region:
         sys.exit(f"make-queries: --region: expected {info['dof']} lo:hi pairs, one per joint")
     lo, hi = [float(b[0]) for b in bounds], [float(b[1]) for b in bounds]
 if a.box == "central":  # rounded inwards to 0.05 rad (for the Panda: its former fixed box)
-    lo, hi = ([round(math.ceil((l + 0.2 * (h - l)) / 0.05 - 1e-9) * 0.05, 4) for l, h in zip(lo, hi)],
-              [round(math.floor((h - 0.2 * (h - l)) / 0.05 + 1e-9) * 0.05, 4) for l, h in zip(lo, hi)])
+    def central(l, h):
+        cl, ch = l + 0.2 * (h - l), h - 0.2 * (h - l)
+        rl, rh = math.ceil(cl / 0.05 - 1e-9) * 0.05, math.floor(ch / 0.05 + 1e-9) * 0.05
+        return (round(rl, 4), round(rh, 4)) if rl < rh else (cl, ch)  # too narrow to round
+    lo, hi = (list(b) for b in zip(*(central(l, h) for l, h in zip(lo, hi))))
 rng = random.Random(a.seed)
 
 

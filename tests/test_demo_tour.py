@@ -29,7 +29,7 @@ def main():
                        cwd=source, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
                        timeout=900)  # one stream, in the order a terminal shows it
     if r.returncode != 0:
-        sys.exit(f"demo.sh failed (exit {r.returncode}):\n{r.stdout[-3000:]}")
+        sys.exit(f"{script} failed (exit {r.returncode}):\n{r.stdout[-3000:]}")
     sections, titles, current = {}, [], None
     for line in r.stdout.splitlines():
         if line.startswith("== "):
@@ -48,7 +48,7 @@ def main():
         if not body or not body[0].startswith("   ("):
             problems.append(f"'{title}': no line under the title saying what it shows")
     last = r.stdout.strip().splitlines()[-1]
-    page = os.path.join(out, "view.html")
+    page = os.path.join(os.path.realpath(out), "view.html")
     if not re.match(r"demo(-\w+)?: done", last) or page not in last:
         problems.append(f"the last line does not give the viewer page ({page}): {last}")
     if not os.path.isfile(page):

@@ -127,7 +127,7 @@ def shell_commands(block, text):
             continue
         if first is None:
             first = block.line + k + 1
-        pending += line[:-1] + " " if line.rstrip().endswith("\\") else line
+        pending += line.rstrip()[:-1] + " " if line.rstrip().endswith("\\") else line
         if line.rstrip().endswith("\\"):
             continue
         command = drop_placeholders(pending)
@@ -176,8 +176,13 @@ def write_inputs(work):
 
 
 def run_shell(work, doc_name, line, command, failures):
-    r = subprocess.run(["bash", "-c", command], cwd=work, capture_output=True, text=True,
-                       stdin=subprocess.DEVNULL, timeout=600)
+    try:
+        r = subprocess.run(["bash", "-c", command], cwd=work, capture_output=True, text=True,
+                           stdin=subprocess.DEVNULL, timeout=300)
+    except subprocess.TimeoutExpired:
+        print(f"{doc_name}:{line}: FAILED (over 300 s): {command}", flush=True)
+        failures.append(f"{doc_name}:{line}")
+        return
     status = "ok" if r.returncode == 0 else f"FAILED (exit {r.returncode})"
     print(f"{doc_name}:{line}: {status}: {command}", flush=True)
     if r.returncode != 0:
@@ -210,8 +215,12 @@ def run_python(work, doc_name, blocks, failures):
     with open(spec_path, "w") as f:
         json.dump(spec, f)
     env = dict(os.environ, PYTHONPATH=os.path.join(work, "build", "python"), MPLBACKEND="Agg")
-    r = subprocess.run(["/usr/bin/python3", "-c", DRIVER, spec_path], cwd=work, env=env,
-                       capture_output=True, text=True, timeout=900)
+    try:
+        r = subprocess.run(["/usr/bin/python3", "-c", DRIVER, spec_path], cwd=work, env=env,
+                           capture_output=True, text=True, timeout=400)
+    except subprocess.TimeoutExpired:
+        failures.append(f"{doc_name} (python blocks: over 400 s)")
+        return
     print(r.stdout, end="", flush=True)
     if r.returncode != 0:
         print(r.stderr[-2000:], flush=True)

@@ -284,7 +284,7 @@ BuildOutcome build_bundle(const Simulator& sim, const BuildSettings& settings, B
         ++h.rejected[e.reason()];
       }
       if (check_hopeless && h.attempts == kHopelessAttempts &&
-          h.valid < kHopelessValidShare * kHopelessAttempts) {
+          h.valid < kHopelessValidShare * kHopelessAttempts && bundle.size() < settings.edges) {
         progress.finish();
         save(false);
         if (control.stats) *control.stats = checkpoints.stats();
