@@ -8,6 +8,7 @@ build=${1:-build}
 bin="$build/bin"
 out=${2:-$build/demo-ur5}  # the outputs (a test gives its own folder)
 mkdir -p "$out"
+out=$(cd "$out" && pwd)  # absolute: the bundle records its robot config's path
 # The UR5's table-top work: shoulder turned at most 0.8 rad from the table, elbow up, the tool
 # pointing down (around q = 0, -1.57, 1.57, -1.57, -1.57, 0); 76% of it is free of collision.
 region="-0.8:0.8,-2.0:-1.0,0.9:2.2,-2.4:-0.8,-2.2:-0.9,-1.0:1.0"

@@ -33,6 +33,7 @@ std::string joints_outside_region(const PlanningContext& ctx, const JointVectorR
 double nearest_edge(const PlanningContext& ctx, const JointVectorRef& q, bool ends) {
   const EdgeIndex* index = ends ? ctx.end_index : ctx.index;
   double nearest = std::numeric_limits<double>::infinity();
+  if (!index && !ends) return nearest;  // no start index: nothing to measure with
   if (!index) {  // no end index: every end state, as edge_ends_near does
     const int n = ctx.bundle->dof();
     for (size_t e = 0; e < ctx.bundle->size(); ++e)
