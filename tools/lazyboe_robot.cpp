@@ -458,6 +458,24 @@ CLI::App* add_init_command(CLI::App& app, RobotSetupOptions& setup, std::string&
   return init;
 }
 
+// `validate-trajectory`'s options.
+CLI::App* add_validate_command(CLI::App& app, std::string& in_path, std::string& env,
+                               std::string& payload_text, std::string& limits_text) {
+  auto* validate = app.add_subcommand(
+      "validate-trajectory",
+      "Check a trajectory CSV at the control rate against the limits and for collision");
+  validate->add_option("--in", in_path, "CSV with header t,q1..qn,dq1..dqn[,more columns]")
+      ->required();
+  validate->add_option("--env", env,
+                       "The scene the trajectory was planned in: an environment file, or a "
+                       "bundled scene by name (table, shelf, empty); required");
+  validate->add_option("--payload", payload_text,
+                       "The payload the arm carries, as a query's \"payload\" (JSON text)");
+  validate->add_option("--end-effector-limits", limits_text,
+                       "End-effector limits, as a query's \"end_effector_limits\" (JSON text)");
+  return validate;
+}
+
 int main(int argc, char** argv) {
   CLI::App app{"Inspect a robot description: joints, kinematics, dynamics, collision."};
   app.require_subcommand(1);
@@ -501,20 +519,8 @@ int main(int argc, char** argv) {
       ->capture_default_str()
       ->check(lazyboe::whole_number(true));
 
-  auto* validate = app.add_subcommand(
-      "validate-trajectory",
-      "Check a trajectory CSV at the control rate against the limits and for collision");
-  validate->add_option("--in", in_path, "CSV with header t,q1..qn,dq1..dqn[,more columns]")
-      ->required();
-  std::string validate_env;
-  validate->add_option("--env", validate_env,
-                       "The scene the trajectory was planned in: an environment file, or a "
-                       "bundled scene by name (table, shelf, empty); required");
-  std::string payload_text, limits_text;
-  validate->add_option("--payload", payload_text,
-                       "The payload the arm carries, as a query's \"payload\" (JSON text)");
-  validate->add_option("--end-effector-limits", limits_text,
-                       "End-effector limits, as a query's \"end_effector_limits\" (JSON text)");
+  std::string validate_env, payload_text, limits_text;
+  CLI::App* validate = add_validate_command(app, in_path, validate_env, payload_text, limits_text);
 
   lazyboe::RobotSetupOptions setup;
   std::string package_path, meshes = "fitted";
