@@ -35,6 +35,19 @@ TEST(RobotInit, WritesTheShippedUr5ConfigAndItsGainsTrackEveryJoint) {
   EXPECT_EQ(written, shipped) << "data/robots/ur5.json is not what init writes: run it again";
 }
 
+// An unknown --meshes is one line naming the option and the three representations.
+TEST(RobotInit, AnUnknownMeshRepresentationIsOneLine) {
+  const std::string out = test::temp_dir() + "/round.json";
+  const test::CommandResult r =
+      test::run(test::tool_path("lazyboe-robot") + kInit + " --meshes round --out " + out);
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.err.find("--meshes: unknown mesh representation 'round' (expected fitted, exact or "
+                       "convex)"),
+            std::string::npos)
+      << r.err;
+  EXPECT_EQ(r.err.find('\n'), r.err.size() - 1) << r.err;  // one line
+}
+
 TEST(RobotInit, TheUr5IsAcceptedByEveryToolInEveryBundledEnvironment) {
   const std::string robot = " --robot " + test::source_path("data/robots/ur5.json");
   const std::string dir = test::temp_dir();

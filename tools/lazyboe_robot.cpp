@@ -397,11 +397,7 @@ int cmd_validate_trajectory(const RobotModel& bundle_robot, const std::string& e
 // Writes the config `init` makes, then says what it assumed and how the gains tracked.
 int cmd_init(RobotSetupOptions options, const std::string& package_path,
              const std::string& meshes) {
-  if (meshes != "fitted" && meshes != "exact" && meshes != "convex")
-    fail("--meshes", "expected fitted, exact or convex");
-  options.meshes = meshes == "exact"    ? MeshRepresentation::Exact
-                   : meshes == "convex" ? MeshRepresentation::Convex
-                                        : MeshRepresentation::Fitted;
+  options.meshes = parse_mesh_representation(meshes, "--meshes");
   options.package_path = split_path_list(package_path);
   refuse_output_as_input({"--out", options.out_path},
                          {{"--urdf", options.urdf_path}, {"--srdf", options.srdf_path}});

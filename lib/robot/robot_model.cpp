@@ -200,6 +200,14 @@ const char* shape_type_name(ShapeType type) {
   return "?";
 }
 
+MeshRepresentation parse_mesh_representation(const std::string& name, const std::string& where) {
+  for (MeshRepresentation r :
+       {MeshRepresentation::Fitted, MeshRepresentation::Exact, MeshRepresentation::Convex}) {
+    if (name == mesh_representation_name(r)) return r;
+  }
+  fail(where, "unknown mesh representation '" + name + "' (expected fitted, exact or convex)");
+}
+
 const char* mesh_representation_name(MeshRepresentation representation) {
   switch (representation) {
     case MeshRepresentation::Exact:
@@ -441,11 +449,7 @@ void read_controller(RobotModel& model, const JsonField& root) {
 }
 
 MeshRepresentation mesh_representation(const JsonField& field) {
-  const std::string name = field.string();
-  if (name == "fitted") return MeshRepresentation::Fitted;
-  if (name == "exact") return MeshRepresentation::Exact;
-  if (name == "convex") return MeshRepresentation::Convex;
-  field.fail("unknown mesh representation '" + name + "' (expected fitted, exact or convex)");
+  return parse_mesh_representation(field.string(), field.where());
 }
 
 // collision.meshes: {"representation": "fitted" | "exact" | "convex", "links": {"<link>":

@@ -85,6 +85,9 @@ const char* shape_type_name(ShapeType type);
 // for GJK: exact for a convex part, never less conservative than the mesh, and fast).
 enum class MeshRepresentation { Fitted, Exact, Convex };
 const char* mesh_representation_name(MeshRepresentation representation);
+// The inverse; throws Error("<where>: unknown mesh representation '<name>' (expected fitted,
+// exact or convex)").
+MeshRepresentation parse_mesh_representation(const std::string& name, const std::string& where);
 
 struct CollisionBody {
   std::string name;
