@@ -6,11 +6,13 @@
 
 #include <cstdint>
 #include <string>
+#include <utility>
 
 #include "lazyboe/bundle/bundle_view.h"
 #include "lazyboe/planning/edge_link_motion.h"
 #include "lazyboe/planning/end_pose_index.h"
 #include "lazyboe/planning/neighbour_index.h"
+#include "lazyboe/planning/parameters.h"
 #include "lazyboe/planning/problem.h"
 #include "lazyboe/planning/workspace_index.h"
 #include "lazyboe/sim/command_profile.h"
@@ -72,6 +74,44 @@ class Planner {
 
   // Forgets everything but the setup (our planners keep no state between solves).
   virtual void clear() {}
+};
+
+// What a planner needs of its context, declared once in its PlannerInfo (registry.h).
+struct PlannerNeeds {
+  bool bundle = false;        // an edge bundle and its neighbour index
+  bool perturbation = false;  // the bundle's perturbation analysis (lazyboe-perturb)
+  bool ompl = false;          // a build with OMPL
+};
+
+// A planner's name and needs as its PlannerInfo declares them: handed to the planners its
+// factory makes (planner_factory), so that each is written once.
+struct PlannerIdentity {
+  std::string name;
+  PlannerNeeds needs;
+};
+
+// The base of the library's planners (as OMPL's base::Planner keeps its name and parameters):
+// the parameter values the registry checked and completed, the identity its PlannerInfo
+// declared, and the context of the last setup. A planner derived from it implements setup
+// (checks, then set_context) and solve.
+class DeclaredPlanner : public Planner {
+ public:
+  DeclaredPlanner(const ParameterValues& values, PlannerIdentity identity)
+      : values_(values), identity_(std::move(identity)) {}
+
+  const std::string& name() const { return identity_.name; }
+  const PlannerNeeds& needs() const { return identity_.needs; }
+
+ protected:
+  const ParameterValues& values() const { return values_; }
+  void set_context(const PlanningContext& context) { context_ = &context; }
+  // The context of the last setup; throws Error("<name>: solve before setup") before any.
+  const PlanningContext& context() const;
+
+ private:
+  ParameterValues values_;
+  PlannerIdentity identity_;
+  const PlanningContext* context_ = nullptr;
 };
 
 }  // namespace lazyboe

@@ -15,6 +15,11 @@
 
 namespace lazyboe {
 
+const PlanningContext& DeclaredPlanner::context() const {
+  if (!context_) fail(name(), "solve before setup");
+  return *context_;
+}
+
 namespace {
 
 // A deque: registering a planner keeps every reference to the others valid.

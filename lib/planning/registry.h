@@ -9,18 +9,13 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "lazyboe/planning/parameters.h"
 #include "lazyboe/planning/planner.h"
 
 namespace lazyboe {
-
-struct PlannerNeeds {
-  bool bundle = false;        // an edge bundle and its neighbour index
-  bool perturbation = false;  // the bundle's perturbation analysis (lazyboe-perturb)
-  bool ompl = false;          // a build with OMPL
-};
 
 struct PlannerInfo {
   std::string name;
@@ -35,6 +30,16 @@ struct PlannerInfo {
   // False when the planner is not built in (OMPL's, without OMPL); `why` says so.
   bool available(std::string* why = nullptr) const;
 };
+
+// The factory of planner class P, made from (values, identity) with the name and needs `info`
+// declares (set them before this): what DeclaredPlanner's subclasses take.
+template <class P>
+decltype(PlannerInfo::make) planner_factory(const PlannerInfo& info) {
+  static_assert(std::is_base_of_v<Planner, P>, "a planner derives from lazyboe::Planner");
+  return [identity = PlannerIdentity{info.name, info.needs}](const ParameterValues& values) {
+    return std::make_unique<P>(values, identity);
+  };
+}
 
 // Every planner, in the order they are listed: the built-in ones, then those registered.
 const std::deque<PlannerInfo>& planner_registry();

@@ -110,6 +110,27 @@ class SearchState {
     if (e >= 0 && e < 3) ++end_effector_rejections_[e];
   }
 
+  // The path from the root to `node`: per node on the way, its step (`step_of(node)`: the
+  // command that reached it) with the rollout that reached it (PathStep::outcome).
+  template <typename StepOf>
+  std::vector<PathStep> path_to(int node, StepOf step_of) const {
+    std::vector<PathStep> steps;
+    for (int u = node; nodes_[u].parent >= 0; u = nodes_[u].parent) {
+      steps.push_back(step_of(nodes_[u]));
+      steps.back().outcome = nodes_[u].outcome();
+    }
+    std::reverse(steps.begin(), steps.end());
+    return steps;
+  }
+
+  // After a solution, for joint goals: whether a state of cost g and heuristic h cannot beat
+  // the best (its cost plus the least remaining arc length, h minus the tolerance): the
+  // searches neither expand nor keep it.
+  bool prunable(double g, double h) const {
+    if (!result_.success || problem_.goal.kind != Goal::Kind::Joint) return false;
+    return g + std::max(0.0, h - problem_.goal.tolerance) >= result_.best_cost;
+  }
+
   // A real node inside the goal region: a solution. `path_to` gives a node's path.
   void solution(int node, const std::function<std::vector<PathStep>(int)>& path_to) {
     offer(nodes_[node].cost, [&] { return path_to(node); });

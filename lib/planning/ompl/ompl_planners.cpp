@@ -47,30 +47,23 @@ PlanResult plan_ompl(const PlanningContext& ctx, SimulatorWorkspace& ws,
                      const PlanningProblem& problem, const std::string& name,
                      const ParameterValues& values);
 
-class OmplPlanner : public Planner {
+class OmplPlanner final : public DeclaredPlanner {
  public:
-  OmplPlanner(const ParameterValues& values, std::string name)
-      : values_(values), name_(std::move(name)) {}
+  using DeclaredPlanner::DeclaredPlanner;
 
   void setup(const PlanningContext& context) override {
     if (!ompl_available()) {
-      fail("planner", "'" + name_ +
+      fail("planner", "'" + name() +
                           "' is not available: lazyboe was built without OMPL (install "
                           "libompl-dev and rebuild)");
     }
-    check_sampling_box(context, name_);
-    context_ = &context;
+    check_sampling_box(context, name());
+    set_context(context);
   }
 
   PlanResult solve(const PlanningProblem& problem, SimulatorWorkspace& ws, RolloutPool*) override {
-    if (!context_) fail(name_, "solve before setup");
-    return plan_ompl(*context_, ws, problem, name_, values_);
+    return plan_ompl(context(), ws, problem, name(), values());
   }
-
- private:
-  ParameterValues values_;
-  std::string name_;
-  const PlanningContext* context_ = nullptr;
 };
 
 PlannerInfo ompl_info(const std::string& name, const std::string& description,
@@ -80,7 +73,7 @@ PlannerInfo ompl_info(const std::string& name, const std::string& description,
   info.description = description;
   info.needs.ompl = true;
   info.parameters = std::move(parameters);
-  info.make = [name](const ParameterValues& v) { return std::make_unique<OmplPlanner>(v, name); };
+  info.make = planner_factory<OmplPlanner>(info);
   return info;
 }
 

@@ -34,7 +34,7 @@ double nearest_edge(const PlanningContext& ctx, const JointVectorRef& q, bool en
   const EdgeIndex* index = ends ? ctx.end_index : ctx.index;
   double nearest = std::numeric_limits<double>::infinity();
   if (!index && !ends) return nearest;  // no start index: nothing to measure with
-  if (!index) {  // no end index: every end state, as edge_ends_near does
+  if (!index) {                         // no end index: every end state, as edge_ends_near does
     const int n = ctx.bundle->dof();
     for (size_t e = 0; e < ctx.bundle->size(); ++e)
       nearest = std::min(nearest, (row(ctx.bundle->qf(e), n) - q).squaredNorm());
@@ -184,7 +184,7 @@ int BundleSearch::pop() {
 bool BundleSearch::skip(int v) {
   if (s_.node(v).expanded || dead(v)) return true;
   if (is_solution(v)) return true;  // already one
-  return prunable(v);
+  return s_.prunable(s_.node(v).cost, s_.node(v).h);
 }
 
 void BundleSearch::expand(int v, Neighbours& neighbours) {
@@ -208,29 +208,17 @@ void BundleSearch::order_by_promise(int v, Neighbours& edges) {
                    [](const auto& x, const auto& y) { return x.second < y.second; });
 }
 
-// After a solution, a node whose cost plus the least remaining arc length (joint goals:
-// distance to the goal minus the tolerance) cannot beat the best is not expanded.
-bool BundleSearch::prunable(int v) {
-  const PlanResult& r = s_.result();
-  if (!r.success || s_.problem().goal.kind != Goal::Kind::Joint) return false;
-  const BundleNode& node = s_.node(v);
-  return node.cost + std::max(0.0, node.h - s_.problem().goal.tolerance) >= r.best_cost;
-}
-
-std::vector<PathStep> BundleSearch::path_to(int node) {
-  std::vector<PathStep> steps;
-  for (int u = node; s_.node(u).parent >= 0; u = s_.node(u).parent) {
-    const CommandProfile c = bundle_.command(s_.node(u).bundle_edge);
-    steps.push_back({s_.node(u).bundle_edge,
-                     std::vector<double>(c.knots, c.knots + c.n_knots * c.dof), c.duration});
-    steps.back().outcome = s_.node(u).outcome();
-  }
-  std::reverse(steps.begin(), steps.end());
-  return steps;
+PathStep bundle_edge_step(const BundleView& bundle, uint32_t e) {
+  const CommandProfile c = bundle.command(e);
+  return {e, std::vector<double>(c.knots, c.knots + c.n_knots * c.dof), c.duration};
 }
 
 void BundleSearch::found(int node) {
-  s_.solution(node, [this](int u) { return path_to(u); });
+  s_.solution(node, [this](int u) {
+    return s_.path_to(u, [this](const BundleNode& n) {
+      return bundle_edge_step(bundle_, static_cast<uint32_t>(n.bundle_edge));
+    });
+  });
 }
 
 bool BundleSearch::needs_rollout(int v, size_t k) { return !simulated(v, expansion_edge(k)); }

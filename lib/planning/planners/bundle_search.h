@@ -40,8 +40,6 @@ class BundleSearch {
  public:
   explicit BundleSearch(const BundleSolve& solve);
 
-  // Checks, at setup, what the search needs beyond a bundle (none here).
-  static void check_context(const PlanningContext& /*ctx*/, const ParameterValues& /*values*/) {}
   virtual ~BundleSearch() = default;
 
   PlanResult run();
@@ -101,8 +99,6 @@ class BundleSearch {
   bool skip(int v);
   void expand(int v, Neighbours& neighbours);
   void order_by_promise(int v, Neighbours& edges);
-  bool prunable(int v);
-  std::vector<PathStep> path_to(int node);
 
   std::unordered_set<uint64_t> simulated_;  // (node, edge) pairs simulated
   std::priority_queue<std::pair<double, int>, std::vector<std::pair<double, int>>, std::greater<>>
@@ -111,6 +107,9 @@ class BundleSearch {
   const Neighbours* expansion_ = nullptr;
   RolloutScheduler ahead_;
 };
+
+// Bundle edge e as a step of a returned path (its command and duration).
+PathStep bundle_edge_step(const BundleView& bundle, uint32_t e);
 
 // theta, as BoE and LazyBoE declare it (default: the bundle's).
 ParameterSpec theta_parameter();
@@ -128,42 +127,33 @@ double bundle_planner_setup(const PlanningContext& context, const ParameterValue
 bool edge_ends_near(const PlanningContext& context, const JointVectorRef& q, double radius,
                     std::vector<std::pair<uint32_t, double>>& scratch);
 
-// A bundle planner: Search (BundleSearch or a subclass, or lazysp's LazySpSearch: a search made
-// from a BundleSolve, with a static check_context and run()) with theta from its parameters or
-// the context.
-template <class Search>
-class BundlePlanner : public Planner {
+// The base of the bundle planners (BoE, LazyBoE, lazysp): setup checks that the context has a
+// bundle and its index (and the perturbation analysis, when the planner's needs say so),
+// resolves theta (the parameter, else the context's) and runs the planner's own checks; each
+// solve runs the planner's search, made from a BundleSolve.
+class BundlePlanner : public DeclaredPlanner {
  public:
-  BundlePlanner(const ParameterValues& values, std::string name, bool perturbation)
-      : values_(values), name_(std::move(name)), perturbation_(perturbation) {}
+  using DeclaredPlanner::DeclaredPlanner;
 
-  void setup(const PlanningContext& context) override {
-    theta_ = bundle_planner_setup(context, values_, name_, perturbation_);
-    Search::check_context(context, values_);
-    context_ = &context;
+  void setup(const PlanningContext& context) final {
+    theta_ = bundle_planner_setup(context, values(), name(), needs().perturbation);
+    check_context(context);
+    set_context(context);
   }
 
   PlanResult solve(const PlanningProblem& problem, SimulatorWorkspace& ws,
-                   RolloutPool* pool) override {
-    if (!context_) fail(name_, "solve before setup");
-    return Search(BundleSolve{*context_, ws, problem, theta_, pool, values_}).run();
+                   RolloutPool* pool) final {
+    return search(BundleSolve{context(), ws, problem, theta_, pool, values()});
   }
 
+ protected:
+  // What the planner needs of the context beyond a bundle; throws Error naming it.
+  virtual void check_context(const PlanningContext& /*context*/) {}
+  // One solve: the planner's own search.
+  virtual PlanResult search(const BundleSolve& solve) = 0;
+
  private:
-  ParameterValues values_;
-  std::string name_;
-  bool perturbation_;
-  const PlanningContext* context_ = nullptr;
   double theta_ = 0;
 };
-
-// The factory of a planner over `Search`, with its name and needs as `info` declares them (set
-// them before this, so that each is written once).
-template <typename Search>
-decltype(PlannerInfo::make) bundle_planner_factory(const PlannerInfo& info) {
-  return [name = info.name, perturbation = info.needs.perturbation](const ParameterValues& v) {
-    return std::make_unique<BundlePlanner<Search>>(v, name, perturbation);
-  };
-}
 
 }  // namespace lazyboe

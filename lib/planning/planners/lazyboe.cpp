@@ -18,14 +18,6 @@ class LazySearch : public BundleSearch {
         transfer_(solve.values.get("lazy_model") == kTransferIndex),
         rng_(solve.problem.seed, 0) {}
 
-  static void check_context(const PlanningContext& ctx, const ParameterValues& values) {
-    if (values.get("lazy_model") == kTransferIndex && !ctx.bundle->has_transfer()) {
-      fail(ctx.bundle->path(),
-           "has no transfer statistics, which lazyboe's lazy_model transfer needs (run "
-           "lazyboe-perturb --replace with this version)");
-    }
-  }
-
  private:
   // Once the lazy search has run dry, every edge it took lazily is simulated from its node (a
   // second, exhaustive pass over the real nodes, as BoE would).
@@ -180,6 +172,22 @@ bool LazySearch::realize(int x, long k) {
   return true;
 }
 
+class LazyBoE final : public BundlePlanner {
+ public:
+  using BundlePlanner::BundlePlanner;
+
+ private:
+  void check_context(const PlanningContext& ctx) override {
+    if (values().get("lazy_model") == kTransferIndex && !ctx.bundle->has_transfer()) {
+      fail(ctx.bundle->path(),
+           "has no transfer statistics, which lazyboe's lazy_model transfer needs (run "
+           "lazyboe-perturb --replace with this version)");
+    }
+  }
+
+  PlanResult search(const BundleSolve& solve) override { return LazySearch(solve).run(); }
+};
+
 }  // namespace
 
 PlannerInfo lazyboe_planner_info() {
@@ -198,7 +206,7 @@ PlannerInfo lazyboe_planner_info() {
       "where a lazy edge ends: its stored end (the paper) or the node moved by the edge's "
       "displacement, with P_lazy_prop under transfer";
   info.parameters = {theta_parameter(), direct_parameter(), model};
-  info.make = bundle_planner_factory<LazySearch>(info);
+  info.make = planner_factory<LazyBoE>(info);
   return info;
 }
 

@@ -82,13 +82,6 @@ class LazySpSearch {
         neighbourhood_(set_.theta *
                        (std::isfinite(ctx_.sim.end_effector.max_tilt) ? kTiltWidening : 1.0)) {}
 
-  // Beyond a bundle, the growth needs a sampling box. A world with end-effector speed or
-  // acceleration limits gets its link's motion table here, in setup, before the solve's clock.
-  static void check_context(const PlanningContext& ctx, const ParameterValues&) {
-    check_sampling_box(ctx, "lazysp");
-    task_motions(ctx);
-  }
-
   PlanResult run();
 
  private:
@@ -107,8 +100,6 @@ class LazySpSearch {
   // A real node: the end of rollout r from `parent` (-1 and r.qf the start: the root).
   int add_real(const RolloutResult& r, int parent, int64_t edge, int command);
   void found(int node, const char* by);
-  std::vector<PathStep> path_to(int node);
-  bool prunable(double g, double h);
   // The lazy search's goal. For a pose goal or goal set (with configurations found by inverse
   // kinematics): the joint distance to the nearest configuration, in the goal within theta of
   // one, from where a validated candidate's end connects (connect_to_goal): the search is then
@@ -123,6 +114,7 @@ class LazySpSearch {
   // The edges' stored link motions when the world limits the link's speed or acceleration
   // (edge_link_motion.h); null otherwise.
   static const EdgeLinkMotion* task_motions(const PlanningContext& ctx);
+  friend class LazySp;
   // Whether edge e's stored motion already breaks the task's speed or acceleration limit (its
   // figures are lower bounds of the motion's peaks): the lazy search leaves it out.
   bool breaks_task(uint32_t e) const {
@@ -258,7 +250,7 @@ int LazySpSearch::search(size_t& expansions, size_t limit) {
   const std::vector<LazySpNode>& nodes = s_.nodes();
   for (size_t v = 0; v < nodes.size(); ++v) {
     const LazySpNode& n = nodes[v];
-    if (s_.in_goal(n.h) || prunable(n.cost, n.h)) continue;  // a solution, or no better one
+    if (s_.in_goal(n.h) || s_.prunable(n.cost, n.h)) continue;  // a solution, or no better one
     Predicted x;
     x.q = n.q;
     x.g = n.cost;
@@ -303,7 +295,7 @@ int LazySpSearch::expand(int p) {
     c.g = g + displacement + risk(e) + set_.edge_penalty;
     c.length = length + displacement;
     const double h = lazy_h(next_);
-    if (prunable(c.length, h)) continue;
+    if (s_.prunable(c.length, h)) continue;
     c.cell = cell(next_);
     if (!improves(c.cell, c.g)) continue;
     c.q = next_;
@@ -415,38 +407,18 @@ int LazySpSearch::add_real(const RolloutResult& r, int parent, int64_t edge, int
 
 void LazySpSearch::found(int node, const char* by) {
   const bool better = !(s_.node(node).cost >= s_.result().best_cost);
-  s_.solution(node, [this](int v) { return path_to(v); });
+  s_.solution(node, [this](int v) {
+    return s_.path_to(v, [this](const LazySpNode& n) {
+      return n.bundle_edge < 0 ? commands_[n.command]
+                               : bundle_edge_step(bundle_, static_cast<uint32_t>(n.bundle_edge));
+    });
+  });
   if (better) s_.result().found_by = by;
 }
 
-std::vector<PathStep> LazySpSearch::path_to(int node) {
-  std::vector<PathStep> steps;
-  for (int u = node; s_.node(u).parent >= 0; u = s_.node(u).parent) {
-    const LazySpNode& n = s_.node(u);
-    if (n.bundle_edge < 0) {
-      steps.push_back(commands_[n.command]);
-    } else {
-      const CommandProfile c = bundle_.command(n.bundle_edge);
-      steps.push_back(
-          {n.bundle_edge, std::vector<double>(c.knots, c.knots + c.n_knots * c.dof), c.duration});
-    }
-    steps.back().outcome = n.outcome();
-  }
-  std::reverse(steps.begin(), steps.end());
-  return steps;
-}
-
-// After a solution, for joint goals: no state whose cost plus the least remaining arc length
-// cannot beat the best (as BoE).
 double LazySpSearch::lazy_h(const JointVector& q) {
   if (!aims_at_configurations_) return s_.heuristic(q);
   return s_.problem().goal.nearest_configuration(q).second;
-}
-
-bool LazySpSearch::prunable(double g, double h) {
-  const PlanResult& r = s_.result();
-  if (!r.success || s_.problem().goal.kind != Goal::Kind::Joint) return false;
-  return g + std::max(0.0, h - s_.problem().goal.tolerance) >= r.best_cost;
 }
 
 const EdgeLinkMotion* LazySpSearch::task_motions(const PlanningContext& ctx) {
@@ -474,6 +446,21 @@ uint64_t LazySpSearch::cell(const JointVector& q) const {
   }
   return h;
 }
+
+class LazySp final : public BundlePlanner {
+ public:
+  using BundlePlanner::BundlePlanner;
+
+ private:
+  // Beyond a bundle, the growth needs a sampling box. A world with end-effector speed or
+  // acceleration limits gets its link's motion table here, in setup, before the solve's clock.
+  void check_context(const PlanningContext& ctx) override {
+    check_sampling_box(ctx, name());
+    LazySpSearch::task_motions(ctx);
+  }
+
+  PlanResult search(const BundleSolve& solve) override { return LazySpSearch(solve).run(); }
+};
 
 }  // namespace
 
@@ -508,7 +495,7 @@ PlannerInfo lazysp_planner_info() {
                      "rad of cost added per edge a scene other than the bundle's may block "
                      "(workspace index), in the first search of each round"),
   };
-  info.make = bundle_planner_factory<LazySpSearch>(info);
+  info.make = planner_factory<LazySp>(info);
   return info;
 }
 

@@ -90,6 +90,17 @@ class SstSearch : public TreeSearch {
   std::vector<char> pruned_;  // removed from the tree (retired, and no children left)
 };
 
+class Sst final : public TreePlanner {
+ public:
+  using TreePlanner::TreePlanner;
+
+ private:
+  PlanResult search(const PlanningContext& context, SimulatorWorkspace& ws,
+                    const PlanningProblem& problem) override {
+    return SstSearch(context, ws, problem, values()).run();
+  }
+};
+
 }  // namespace
 
 ParameterSpec selection_radius_parameter() {
@@ -107,7 +118,7 @@ PlannerInfo sst_planner_info() {
   info.description = "Stable Sparse RRT: Best-Near selection and witness pruning; anytime";
   info.parameters = {goal_bias_parameter(), selection_radius_parameter(),
                      pruning_ratio_parameter()};
-  info.make = tree_planner_factory<SstSearch>(info);
+  info.make = planner_factory<Sst>(info);
   return info;
 }
 

@@ -53,7 +53,9 @@ PlanResult TreeSearch::run() {
     added(id);
     const int in_goal = s_.in_goal(c.h) ? id : connect(id);
     if (in_goal >= 0) {
-      s_.solution(in_goal, [this](int u) { return path_to(u); });
+      s_.solution(in_goal, [this](int u) {
+        return s_.path_to(u, [this](const TreeNode& n) { return commands_[n.command]; });
+      });
       if (stop_at_solution()) break;
     }
   }
@@ -107,16 +109,6 @@ int TreeSearch::add(TreeNode c, int from) {
   retired_.push_back(0);
   if (from >= 0) ++children_[from];
   return id;
-}
-
-std::vector<PathStep> TreeSearch::path_to(int node) {
-  std::vector<PathStep> steps;
-  for (int u = node; s_.node(u).parent >= 0; u = s_.node(u).parent) {
-    steps.push_back(commands_[s_.node(u).command]);
-    steps.back().outcome = s_.node(u).outcome();
-  }
-  std::reverse(steps.begin(), steps.end());
-  return steps;
 }
 
 }  // namespace lazyboe

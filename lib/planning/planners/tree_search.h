@@ -75,7 +75,6 @@ class TreeSearch {
   void sample(JointVector& x);
   int connect(int v);  // the goal node, or -1
   int add(TreeNode c, int from);
-  std::vector<PathStep> path_to(int node);
 
   double goal_bias_;
   std::vector<PathStep> commands_;
@@ -86,36 +85,26 @@ class TreeSearch {
 // The context must have a sampling box of robot.dof joints.
 void check_sampling_box(const PlanningContext& context, const std::string& planner);
 
-// A sampling planner: Search (TreeSearch or a subclass) with its parameter values.
-template <class Search>
-class TreePlanner : public Planner {
+// The base of the sampling planners (RRT, SST): setup checks the context's sampling box; each
+// solve runs the planner's search.
+class TreePlanner : public DeclaredPlanner {
  public:
-  TreePlanner(const ParameterValues& values, std::string name)
-      : values_(values), name_(std::move(name)) {}
+  using DeclaredPlanner::DeclaredPlanner;
 
-  void setup(const PlanningContext& context) override {
-    check_sampling_box(context, name_);
-    context_ = &context;
+  void setup(const PlanningContext& context) final {
+    check_sampling_box(context, name());
+    set_context(context);
   }
 
-  PlanResult solve(const PlanningProblem& problem, SimulatorWorkspace& ws, RolloutPool*) override {
-    if (!context_) fail(name_, "solve before setup");
-    return Search(*context_, ws, problem, values_).run();
+  PlanResult solve(const PlanningProblem& problem, SimulatorWorkspace& ws, RolloutPool*) final {
+    return search(context(), ws, problem);
   }
 
- private:
-  ParameterValues values_;
-  std::string name_;
-  const PlanningContext* context_ = nullptr;
+ protected:
+  // One solve: the planner's own search.
+  virtual PlanResult search(const PlanningContext& context, SimulatorWorkspace& ws,
+                            const PlanningProblem& problem) = 0;
 };
-
-// The factory of a planner over `Search`, named as `info` declares it (set the name first).
-template <typename Search>
-decltype(PlannerInfo::make) tree_planner_factory(const PlannerInfo& info) {
-  return [name = info.name](const ParameterValues& v) {
-    return std::make_unique<TreePlanner<Search>>(v, name);
-  };
-}
 
 // A goal-biased sample: a joint goal with probability goal_bias, else uniform in the context's
 // sampling box.
