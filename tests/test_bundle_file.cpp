@@ -15,9 +15,11 @@
 #include <functional>
 #include <memory>
 #include <random>
+#include <regex>
 #include <thread>
 
 #include "lazyboe/bundle/bundle_file.h"
+#include "lazyboe/bundle/bundle_format.h"
 #include "lazyboe/bundle/bundle_view.h"
 #include "lazyboe/bundle/hdf5_handle.h"
 #include "lazyboe/common/atomic_file.h"
@@ -815,6 +817,54 @@ TEST(BundleFile, WriterRefusesWrongSizesOfTheTransferStatistics) {
     expect_error(message, path, {field});
     EXPECT_FALSE(fs::exists(path));
   }
+}
+
+// The format described once: schemas/bundle.md's dataset tables list the library's table
+// (bundle_format.h) in its order, with the same shape, type and group.
+TEST(BundleFormat, SchemaDocumentListsTheDatasetTable) {
+  std::ifstream in(test::source_path("schemas/bundle.md"));
+  ASSERT_TRUE(in) << "schemas/bundle.md";
+  const std::regex row(R"(^\| `(/[a-z0-9_/]+)` \| ([^|]+) \| (\w+) \|)");
+  std::vector<std::array<std::string, 3>> documented;
+  for (std::string line; std::getline(in, line);) {
+    std::smatch m;
+    if (std::regex_search(line, m, row)) documented.push_back({m[1], m[2], m[3]});
+  }
+  const auto& table = bundle_datasets();
+  ASSERT_EQ(documented.size(), table.size());
+  for (size_t i = 0; i < table.size(); ++i) {
+    const BundleDatasetSpec& spec = table[i];
+    EXPECT_EQ(static_cast<size_t>(spec.id), i);
+    EXPECT_EQ(documented[i][0], spec.path);
+    EXPECT_EQ(documented[i][1], shape_rule_text(spec)) << spec.path;
+    EXPECT_EQ(documented[i][2], element_type_name(spec.type)) << spec.path;
+    const bool in_group = std::string(spec.path).rfind("/perturbation/", 0) == 0;
+    EXPECT_EQ(in_group, spec.presence != Presence::Always) << spec.path;
+  }
+}
+
+// A written bundle with every group holds every dataset of the table with the table's shape,
+// each with a verified checksum, in the table's order.
+TEST(BundleFormat, WrittenFilesFollowTheTable) {
+  const std::string path = fresh_path("format");
+  const Bundle b = viewable_bundle_with_transfer(12, 7, 21);
+  write_bundle(path, b);
+  const std::vector<DatasetVerification> verified = verify_bundle_checksums(path);
+  ASSERT_EQ(verified.size(), kBundleDatasetCount);
+  h5::File file = h5::open_file(path);
+  const BundleRows rows{b.size(), b.knots.size() / 7, b.sample_q.size() / 7};
+  for (const BundleDatasetSpec& spec : bundle_datasets()) {
+    EXPECT_EQ(verified[static_cast<size_t>(spec.id)].dataset, spec.path);
+    EXPECT_EQ(verified[static_cast<size_t>(spec.id)].status, DatasetVerification::Status::Verified);
+    EXPECT_EQ(h5::dataset_shape(path, file, spec.path), dataset_shape(spec, rows, 7)) << spec.path;
+  }
+  // Without an analysis, only the datasets always there.
+  const std::string plain = fresh_path("format-plain");
+  write_bundle(plain, random_bundle(12, 7, 22));
+  size_t always = 0;
+  for (const BundleDatasetSpec& spec : bundle_datasets())
+    always += spec.presence == Presence::Always;
+  EXPECT_EQ(verify_bundle_checksums(plain).size(), always);
 }
 
 }  // namespace

@@ -1,7 +1,9 @@
 #include "lazyboe/bundle/bundle_check.h"
 
 #include <cmath>
+#include <variant>
 
+#include "lazyboe/bundle/bundle.h"
 #include "lazyboe/bundle/bundle_file.h"
 #include "lazyboe/common/error.h"
 #include "lazyboe/common/numbers.h"
@@ -72,32 +74,56 @@ void check_at_most(const std::string& where, const char* name, const uint64_t* c
 }
 
 void check_perturbation(const BundleArrays& a, const std::string& where) {
+  using Id = BundleDatasetId;
   const uint64_t n = a.edges;
-  check_at_most(where, ds::pert_done, a.done, "perturbations", nullptr, a.perturbations, n);
-  check_at_most(where, ds::pert_valid, a.valid, "done", a.done, 0, n);
-  check_at_most(where, ds::pert_collision, a.collision, "done", a.done, 0, n);
-  check_at_most(where, ds::pert_lazy, a.lazy, "valid", a.valid, 0, n);
-  check_at_most(where, ds::transfer_lazy, a.transfer_lazy, "valid", a.valid, 0, n);
+  const uint64_t* done = a.of<uint64_t>(Id::Done);
+  const uint64_t* valid = a.of<uint64_t>(Id::Valid);
+  check_at_most(where, ds::pert_done, done, "perturbations", nullptr, a.perturbations, n);
+  check_at_most(where, ds::pert_valid, valid, "done", done, 0, n);
+  check_at_most(where, ds::pert_collision, a.of<uint64_t>(Id::Collision), "done", done, 0, n);
+  check_at_most(where, ds::pert_lazy, a.of<uint64_t>(Id::Lazy), "valid", valid, 0, n);
+  check_at_most(where, ds::transfer_lazy, a.of<uint64_t>(Id::TransferLazy), "valid", valid, 0, n);
   const double inf = HUGE_VAL;
-  check_values(where, ds::pert_max_error, a.max_error, n, 0, inf, true);
-  check_values(where, ds::transfer_max_error, a.transfer_max_error, n, 0, inf, true);
-  check_values(where, ds::p_lazy_prop, a.p_lazy_prop, n, 0, 1, false);
-  check_values(where, ds::p_collision, a.p_collision, n, 0, 1, false);
-  check_values(where, ds::p_lazy_prop_transfer, a.p_lazy_prop_transfer, n, 0, 1, false);
+  check_values(where, ds::pert_max_error, a.of<double>(Id::MaxError), n, 0, inf, true);
+  check_values(where, ds::transfer_max_error, a.of<double>(Id::TransferMaxError), n, 0, inf, true);
+  check_values(where, ds::p_lazy_prop, a.of<double>(Id::PLazyProp), n, 0, 1, false);
+  check_values(where, ds::p_collision, a.of<double>(Id::PCollision), n, 0, 1, false);
+  check_values(where, ds::p_lazy_prop_transfer, a.of<double>(Id::PLazyPropTransfer), n, 0, 1,
+               false);
 }
 
 }  // namespace
 
+BundleArrays arrays_of(const Bundle& b) {
+  BundleArrays a;
+  a.edges = b.size();
+  a.dof = static_cast<uint64_t>(b.dof());
+  a.knot_rows = a.dof ? b.knots.size() / a.dof : 0;
+  a.sample_rows = a.dof ? b.sample_q.size() / a.dof : 0;
+  a.perturbations = b.perturbation.present ? b.perturbation.perturbations : 0;
+  for (const BundleDatasetSpec& spec : bundle_datasets()) {
+    if (!bundle_has(b, spec)) continue;
+    std::visit([&](const auto* data) { a.set(spec.id, data->data()); }, bundle_array(b, spec.id));
+  }
+  return a;
+}
+
 void check_bundle_arrays(const BundleArrays& a, const std::string& where) {
-  check_offsets(where, ds::knot_offset, a.knot_offset, a.edges, a.knot_rows, ds::knots);
-  check_offsets(where, ds::sample_offset, a.sample_offset, a.edges, a.sample_rows, ds::sample_q);
-  check_rows(where, ds::q0, a.q0, a.edges, a.dof, kMaxPosition, "edge");
-  check_rows(where, ds::qf, a.qf, a.edges, a.dof, kMaxPosition, "edge");
-  check_values(where, ds::duration, a.duration, a.edges, 0, kMaxDuration, false);
-  check_values(where, ds::command_duration, a.command_duration, a.edges, 0, kMaxDuration, false);
-  check_rows(where, ds::knots, a.knots, a.knot_rows, a.dof, kMaxVelocity, "row");
-  check_rows(where, ds::sample_q, a.sample_q, a.sample_rows, a.dof, kMaxPosition, "row");
-  check_rows(where, ds::sample_dq, a.sample_dq, a.sample_rows, a.dof, kMaxVelocity, "row");
+  using Id = BundleDatasetId;
+  check_offsets(where, ds::knot_offset, a.of<uint64_t>(Id::KnotOffset), a.edges, a.knot_rows,
+                ds::knots);
+  check_offsets(where, ds::sample_offset, a.of<uint64_t>(Id::SampleOffset), a.edges, a.sample_rows,
+                ds::sample_q);
+  check_rows(where, ds::q0, a.of<double>(Id::Q0), a.edges, a.dof, kMaxPosition, "edge");
+  check_rows(where, ds::qf, a.of<double>(Id::Qf), a.edges, a.dof, kMaxPosition, "edge");
+  check_values(where, ds::duration, a.of<double>(Id::Duration), a.edges, 0, kMaxDuration, false);
+  check_values(where, ds::command_duration, a.of<double>(Id::CommandDuration), a.edges, 0,
+               kMaxDuration, false);
+  check_rows(where, ds::knots, a.of<double>(Id::Knots), a.knot_rows, a.dof, kMaxVelocity, "row");
+  check_rows(where, ds::sample_q, a.of<float>(Id::SampleQ), a.sample_rows, a.dof, kMaxPosition,
+             "row");
+  check_rows(where, ds::sample_dq, a.of<float>(Id::SampleDq), a.sample_rows, a.dof, kMaxVelocity,
+             "row");
   check_perturbation(a, where);
 }
 

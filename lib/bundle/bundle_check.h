@@ -6,29 +6,32 @@
 // naming the file, the dataset, the edge and the value.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <string>
 
+#include "lazyboe/bundle/bundle_format.h"
+
 namespace lazyboe {
 
+// A bundle's arrays, wherever they are (a Bundle in memory, a mapped file): per dataset of the
+// table (bundle_format.h) a pointer, null when absent or not to be checked.
 struct BundleArrays {
   uint64_t edges = 0, dof = 0, knot_rows = 0, sample_rows = 0;
-  const double* q0 = nullptr;                // edges x dof
-  const double* qf = nullptr;                // edges x dof
-  const double* duration = nullptr;          // edges
-  const double* command_duration = nullptr;  // edges
-  const uint64_t* knot_offset = nullptr;     // edges + 1
-  const uint64_t* sample_offset = nullptr;   // edges + 1
-  const double* knots = nullptr;             // knot_rows x dof
-  const float* sample_q = nullptr;           // sample_rows x dof
-  const float* sample_dq = nullptr;          // sample_rows x dof
-  // /perturbation, when present.
-  uint64_t perturbations = 0;  // p, the target per edge
-  const uint64_t *done = nullptr, *valid = nullptr, *lazy = nullptr, *collision = nullptr,
-                 *transfer_lazy = nullptr;
-  const double *max_error = nullptr, *p_lazy_prop = nullptr, *p_collision = nullptr,
-               *transfer_max_error = nullptr, *p_lazy_prop_transfer = nullptr;
+  uint64_t perturbations = 0;  // p, the target per edge (with /perturbation)
+  std::array<const void*, kBundleDatasetCount> data{};
+
+  // The elements of dataset `id` (its table type is T), or null.
+  template <typename T>
+  const T* of(BundleDatasetId id) const {
+    return static_cast<const T*>(data[static_cast<size_t>(id)]);
+  }
+  void set(BundleDatasetId id, const void* array) { data[static_cast<size_t>(id)] = array; }
 };
+
+struct Bundle;
+// The arrays of a bundle in memory (knot and sample rows from the sizes and dof).
+BundleArrays arrays_of(const Bundle& bundle);
 
 // The accepted ranges (schemas/bundle.md): joint positions within 1e3 rad (or m), velocities
 // within 1e4 rad/s, durations in [0, 1e3] s, probabilities in [0, 1], errors >= 0 or NaN (no

@@ -3,8 +3,12 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <type_traits>
+#include <utility>
+#include <variant>
 
 #include "lazyboe/bundle/bundle_check.h"
+#include "lazyboe/bundle/bundle_format.h"
 #include "lazyboe/bundle/hdf5_handle.h"
 #include "lazyboe/common/atomic_file.h"
 #include "lazyboe/common/error.h"
@@ -50,6 +54,22 @@ void check_size(const std::string& where, const std::string& field, size_t found
   if (found != expected)
     fail(where, "bundle." + field + ": " + str(found) + " values, expected " + expected_text +
                     " = " + str(expected));
+}
+
+// What an in-memory array's size should be, in words, for check_bundle's errors.
+std::string memory_size_text(const BundleDatasetSpec& spec, uint64_t edges, uint64_t dof) {
+  switch (spec.rows) {
+    case RowRule::Edges:
+      return spec.per_joint ? "edges x dof = " + str(edges) + " x " + str(dof)
+                            : "edges (duration.size())";
+    case RowRule::EdgesPlusOne:
+      return "edges + 1";
+    case RowRule::KnotRows:
+      return "rows of knots x dof";
+    case RowRule::SampleRows:
+      return "sample_q.size()";
+  }
+  return "";
 }
 
 // Real attributes: finite and non-negative (an empty bundle written from default settings has
@@ -209,25 +229,8 @@ void write_checked(const std::string& where, hid_t file, const char* name,
   h5::write_attr_string(where, dset, kChecksumAttribute, std::string(kChecksumPrefix) + hash.hex());
 }
 
-void write_edges(const std::string& tmp, hid_t file, const Bundle& b) {
-  const uint64_t n = b.size(), dof = static_cast<uint64_t>(b.dof());
-  const uint64_t k = b.knots.size() / dof, s = b.sample_q.size() / dof;
-  h5::create_group(tmp, file, "/edges");
-  h5::create_group(tmp, file, "/controls");
-  h5::create_group(tmp, file, "/trajectory");
-  write_checked(tmp, file, ds::q0, b.q0, {n, dof});
-  write_checked(tmp, file, ds::qf, b.qf, {n, dof});
-  write_checked(tmp, file, ds::duration, b.duration, {n});
-  write_checked(tmp, file, ds::command_duration, b.command_duration, {n});
-  write_checked(tmp, file, ds::attempt, b.attempt, {n});
-  write_checked(tmp, file, ds::knot_offset, b.knot_offset, {n + 1});
-  write_checked(tmp, file, ds::sample_offset, b.sample_offset, {n + 1});
-  write_checked(tmp, file, ds::knots, b.knots, {k, dof});
-  write_checked(tmp, file, ds::sample_q, b.sample_q, {s, dof});
-  write_checked(tmp, file, ds::sample_dq, b.sample_dq, {s, dof});
-}
-
-void write_perturbation(const std::string& tmp, hid_t file, const Perturbation& p, uint64_t n) {
+// The /perturbation group and its attributes (its datasets are written with the others).
+void write_perturbation_group(const std::string& tmp, hid_t file, const Perturbation& p) {
   h5::Group g = h5::create_group(tmp, file, ds::perturbation);
   h5::write_attr_bool(tmp, g, "complete", p.complete);
   h5::write_attr_f64(tmp, g, "theta", p.theta);
@@ -238,60 +241,39 @@ void write_perturbation(const std::string& tmp, hid_t file, const Perturbation& 
   h5::write_attr_string(
       tmp, g, "distribution",
       "start + d, d = r u: u uniform on the unit sphere, r uniform in (0, theta]");
-  write_checked(tmp, file, ds::pert_done, p.done, {n});
-  write_checked(tmp, file, ds::pert_valid, p.valid, {n});
-  write_checked(tmp, file, ds::pert_lazy, p.lazy, {n});
-  write_checked(tmp, file, ds::pert_collision, p.collision, {n});
-  write_checked(tmp, file, ds::pert_max_error, p.max_error, {n});
-  write_checked(tmp, file, ds::p_lazy_prop, p.p_lazy_prop, {n});
-  write_checked(tmp, file, ds::p_collision, p.p_collision, {n});
-  if (p.has_transfer) {
-    write_checked(tmp, file, ds::transfer_lazy, p.transfer_lazy, {n});
-    write_checked(tmp, file, ds::transfer_max_error, p.transfer_max_error, {n});
-    write_checked(tmp, file, ds::p_lazy_prop_transfer, p.p_lazy_prop_transfer, {n});
+}
+
+BundleRows rows_of(const Bundle& b) {
+  const uint64_t dof = static_cast<uint64_t>(b.dof());
+  return {b.size(), b.knots.size() / dof, b.sample_q.size() / dof};
+}
+
+// Every dataset the bundle holds, in the table's order.
+void write_datasets(const std::string& tmp, hid_t file, const Bundle& b) {
+  h5::create_group(tmp, file, "/edges");
+  h5::create_group(tmp, file, "/controls");
+  h5::create_group(tmp, file, "/trajectory");
+  bool group_written = false;  // /perturbation, before its first dataset (the file's order)
+  for (const BundleDatasetSpec& spec : bundle_datasets()) {
+    if (!bundle_has(b, spec)) continue;
+    if (spec.presence != Presence::Always && !std::exchange(group_written, true))
+      write_perturbation_group(tmp, file, b.perturbation);
+    const std::vector<uint64_t> dims =
+        dataset_shape(spec, rows_of(b), static_cast<uint64_t>(b.dof()));
+    std::visit([&](const auto* data) { write_checked(tmp, file, spec.path, *data, dims); },
+               bundle_array(b, spec.id));
   }
 }
 
 // The dataset bytes of the file, to size its memory image at once.
 uint64_t payload_bytes(const Bundle& b) {
-  const Perturbation& p = b.perturbation;
-  return 8 * (b.q0.size() + b.qf.size() + b.duration.size() + b.command_duration.size() +
-              b.attempt.size() + b.knot_offset.size() + b.sample_offset.size() + b.knots.size()) +
-         4 * (b.sample_q.size() + b.sample_dq.size()) +
-         (p.present ? 8 * b.size() * (p.has_transfer ? 10 : 7) : 0);
-}
-
-BundleArrays arrays_of(const Bundle& b, uint64_t knot_rows, uint64_t sample_rows) {
-  BundleArrays a;
-  a.edges = b.size();
-  a.dof = static_cast<uint64_t>(b.dof());
-  a.knot_rows = knot_rows;
-  a.sample_rows = sample_rows;
-  a.q0 = b.q0.data();
-  a.qf = b.qf.data();
-  a.duration = b.duration.data();
-  a.command_duration = b.command_duration.data();
-  a.knot_offset = b.knot_offset.data();
-  a.sample_offset = b.sample_offset.data();
-  a.knots = b.knots.data();
-  a.sample_q = b.sample_q.data();
-  a.sample_dq = b.sample_dq.data();
-  const Perturbation& p = b.perturbation;
-  if (!p.present) return a;
-  a.perturbations = p.perturbations;
-  a.done = p.done.data();
-  a.valid = p.valid.data();
-  a.lazy = p.lazy.data();
-  a.collision = p.collision.data();
-  a.max_error = p.max_error.data();
-  a.p_lazy_prop = p.p_lazy_prop.data();
-  a.p_collision = p.p_collision.data();
-  if (p.has_transfer) {
-    a.transfer_lazy = p.transfer_lazy.data();
-    a.transfer_max_error = p.transfer_max_error.data();
-    a.p_lazy_prop_transfer = p.p_lazy_prop_transfer.data();
+  uint64_t bytes = 0;
+  for (const BundleDatasetSpec& spec : bundle_datasets()) {
+    if (!bundle_has(b, spec)) continue;
+    std::visit([&](const auto* data) { bytes += data->size() * sizeof((*data)[0]); },
+               bundle_array(b, spec.id));
   }
-  return a;
+  return bytes;
 }
 
 }  // namespace
@@ -302,37 +284,20 @@ void check_bundle(const Bundle& b, const std::string& where) {
     fail(where, "bundle.header.schema_version: " + std::to_string(h.schema_version) +
                     ", this lazyboe writes schema version " + std::to_string(kBundleSchemaVersion));
   check_header(where, "bundle.header.", h);
-  const size_t n = b.duration.size();
   const size_t dof = static_cast<size_t>(h.dof);
-  const std::string nd = "edges x dof = " + str(n) + " x " + str(dof);
-  check_size(where, "q0", b.q0.size(), n * dof, nd);
-  check_size(where, "qf", b.qf.size(), n * dof, nd);
-  check_size(where, "command_duration", b.command_duration.size(), n, "edges (duration.size())");
-  check_size(where, "attempt", b.attempt.size(), n, "edges (duration.size())");
-  check_size(where, "knot_offset", b.knot_offset.size(), n + 1, "edges + 1");
-  check_size(where, "sample_offset", b.sample_offset.size(), n + 1, "edges + 1");
   if (b.knots.size() % dof != 0)
     fail(where,
          "bundle.knots: " + str(b.knots.size()) + " values, not a multiple of dof = " + str(dof));
   if (b.sample_q.size() % dof != 0)
     fail(where, "bundle.sample_q: " + str(b.sample_q.size()) +
                     " values, not a multiple of dof = " + str(dof));
-  check_size(where, "sample_dq", b.sample_dq.size(), b.sample_q.size(), "sample_q.size()");
-  if (b.perturbation.present) {
-    const Perturbation& p = b.perturbation;
-    const std::string e = "edges (duration.size())";
-    check_size(where, "perturbation.done", p.done.size(), n, e);
-    check_size(where, "perturbation.valid", p.valid.size(), n, e);
-    check_size(where, "perturbation.lazy", p.lazy.size(), n, e);
-    check_size(where, "perturbation.collision", p.collision.size(), n, e);
-    check_size(where, "perturbation.max_error", p.max_error.size(), n, e);
-    check_size(where, "perturbation.p_lazy_prop", p.p_lazy_prop.size(), n, e);
-    check_size(where, "perturbation.p_collision", p.p_collision.size(), n, e);
-    if (p.has_transfer) {
-      check_size(where, "perturbation.transfer_lazy", p.transfer_lazy.size(), n, e);
-      check_size(where, "perturbation.transfer_max_error", p.transfer_max_error.size(), n, e);
-      check_size(where, "perturbation.p_lazy_prop_transfer", p.p_lazy_prop_transfer.size(), n, e);
-    }
+  const BundleRows rows = rows_of(b);
+  for (const BundleDatasetSpec& spec : bundle_datasets()) {
+    if (!bundle_has(b, spec)) continue;
+    const size_t found =
+        std::visit([](const auto* data) { return data->size(); }, bundle_array(b, spec.id));
+    const size_t expected = dataset_rows(spec, rows) * (spec.per_joint ? dof : 1);
+    check_size(where, spec.field, found, expected, memory_size_text(spec, rows.edges, dof));
   }
   check_offsets(where, "bundle.knot_offset", b.knot_offset, b.knots.size() / dof, "bundle.knots");
   check_offsets(where, "bundle.sample_offset", b.sample_offset, b.sample_q.size() / dof,
@@ -346,8 +311,7 @@ void write_bundle(const std::string& path, const Bundle& b) {
   // clear error naming `path` (HDF5 itself, failing a write, leaves a state that crashes at exit).
   h5::File file = h5::create_memory_file(path, payload_bytes(b) + (1 << 20));
   write_header(path, file, b.header, b.size());
-  write_edges(path, file, b);
-  if (b.perturbation.present) write_perturbation(path, file, b.perturbation, b.size());
+  write_datasets(path, file, b);
   const std::vector<unsigned char> image = h5::memory_file_image(path, file);
   file.close();
   out.write_all(image.data(), image.size());
@@ -365,6 +329,23 @@ BundleHeader read_bundle_header(const std::string& path, uint64_t* edges) {
   return read_header(path, file, edges);
 }
 
+namespace {
+
+// The /perturbation group's attributes (present, with the datasets read from the table).
+void read_perturbation_group(const std::string& path, hid_t file, Perturbation& p) {
+  h5::Group g(H5Gopen2(file, ds::perturbation, H5P_DEFAULT));
+  if (!g.valid()) fail(path, std::string(ds::perturbation) + ": cannot open group");
+  p.present = true;
+  p.complete = h5::read_attr_bool(path, g, "complete");
+  p.theta = h5::read_attr_f64(path, g, "theta");
+  p.perturbations = h5::read_attr_u64(path, g, "perturbations");
+  p.seed = h5::read_attr_u64(path, g, "seed");
+  p.wall_seconds = h5::read_attr_f64(path, g, "wall_seconds");
+  p.simulated_seconds = h5::read_attr_f64(path, g, "simulated_seconds");
+}
+
+}  // namespace
+
 Bundle read_bundle(const std::string& path) {
   h5::File file = h5::open_file(path);
   Bundle b;
@@ -372,59 +353,30 @@ Bundle read_bundle(const std::string& path) {
   b.header = read_header(path, file, &n);
   const uint64_t dof = static_cast<uint64_t>(b.header.dof);
 
-  // Every shape first (cheap), then the data.
-  expect_shape(path, file, ds::q0, {n, dof}, "edges x dof");
-  expect_shape(path, file, ds::qf, {n, dof}, "edges x dof");
-  expect_shape(path, file, ds::duration, {n}, "edges");
-  expect_shape(path, file, ds::command_duration, {n}, "edges");
-  expect_shape(path, file, ds::attempt, {n}, "edges");
-  expect_shape(path, file, ds::knot_offset, {n + 1}, "edges + 1");
-  expect_shape(path, file, ds::sample_offset, {n + 1}, "edges + 1");
   const uint64_t k = rows_of(path, file, ds::knots, dof);
   const uint64_t s = rows_of(path, file, ds::sample_q, dof);
-  expect_shape(path, file, ds::sample_dq, {s, dof}, "rows of /trajectory/q x dof");
-
-  b.knot_offset = h5::read_dataset<uint64_t>(path, file, ds::knot_offset, {n + 1});
-  check_offsets(path, ds::knot_offset, b.knot_offset, k, ds::knots);
-  b.sample_offset = h5::read_dataset<uint64_t>(path, file, ds::sample_offset, {n + 1});
-  check_offsets(path, ds::sample_offset, b.sample_offset, s, ds::sample_q);
-
-  b.q0 = h5::read_dataset<double>(path, file, ds::q0, {n, dof});
-  b.qf = h5::read_dataset<double>(path, file, ds::qf, {n, dof});
-  b.duration = h5::read_dataset<double>(path, file, ds::duration, {n});
-  b.command_duration = h5::read_dataset<double>(path, file, ds::command_duration, {n});
-  b.attempt = h5::read_dataset<uint64_t>(path, file, ds::attempt, {n});
-  b.knots = h5::read_dataset<double>(path, file, ds::knots, {k, dof});
-  b.sample_q = h5::read_dataset<float>(path, file, ds::sample_q, {s, dof});
-  b.sample_dq = h5::read_dataset<float>(path, file, ds::sample_dq, {s, dof});
-  if (h5::exists(file, ds::perturbation)) {
-    Perturbation& p = b.perturbation;
-    h5::Group g(H5Gopen2(file, ds::perturbation, H5P_DEFAULT));
-    if (!g.valid()) fail(path, std::string(ds::perturbation) + ": cannot open group");
-    const std::string where = path;
-    p.present = true;
-    p.complete = h5::read_attr_bool(where, g, "complete");
-    p.theta = h5::read_attr_f64(where, g, "theta");
-    p.perturbations = h5::read_attr_u64(where, g, "perturbations");
-    p.seed = h5::read_attr_u64(where, g, "seed");
-    p.wall_seconds = h5::read_attr_f64(where, g, "wall_seconds");
-    p.simulated_seconds = h5::read_attr_f64(where, g, "simulated_seconds");
-    p.done = h5::read_dataset<uint64_t>(path, file, ds::pert_done, {n});
-    p.valid = h5::read_dataset<uint64_t>(path, file, ds::pert_valid, {n});
-    p.lazy = h5::read_dataset<uint64_t>(path, file, ds::pert_lazy, {n});
-    p.collision = h5::read_dataset<uint64_t>(path, file, ds::pert_collision, {n});
-    p.max_error = h5::read_dataset<double>(path, file, ds::pert_max_error, {n});
-    p.p_lazy_prop = h5::read_dataset<double>(path, file, ds::p_lazy_prop, {n});
-    p.p_collision = h5::read_dataset<double>(path, file, ds::p_collision, {n});
-    // The transfer statistics: absent from analyses written before them.
-    if (has_transfer_datasets(path, file)) {
-      p.has_transfer = true;
-      p.transfer_lazy = h5::read_dataset<uint64_t>(path, file, ds::transfer_lazy, {n});
-      p.transfer_max_error = h5::read_dataset<double>(path, file, ds::transfer_max_error, {n});
-      p.p_lazy_prop_transfer = h5::read_dataset<double>(path, file, ds::p_lazy_prop_transfer, {n});
-    }
+  if (h5::exists(file, ds::perturbation)) read_perturbation_group(path, file, b.perturbation);
+  b.perturbation.has_transfer = b.perturbation.present && has_transfer_datasets(path, file);
+  const BundleRows rows{n, k, s};
+  // Every shape first (cheap), then the data.
+  for (const BundleDatasetSpec& spec : bundle_datasets()) {
+    if (bundle_has(b, spec))
+      expect_shape(path, file, spec.path, dataset_shape(spec, rows, dof), shape_rule_text(spec));
   }
-  check_bundle_arrays(arrays_of(b, k, s), path);
+  for (const BundleDatasetSpec& spec : bundle_datasets()) {
+    if (!bundle_has(b, spec)) continue;
+    std::visit(
+        [&](auto* data) {
+          using T = typename std::decay_t<decltype(*data)>::value_type;
+          *data = h5::read_dataset<T>(path, file, spec.path, dataset_shape(spec, rows, dof));
+        },
+        bundle_array(b, spec.id));
+    if (spec.id == BundleDatasetId::KnotOffset)
+      check_offsets(path, ds::knot_offset, b.knot_offset, k, ds::knots);
+    if (spec.id == BundleDatasetId::SampleOffset)
+      check_offsets(path, ds::sample_offset, b.sample_offset, s, ds::sample_q);
+  }
+  check_bundle_arrays(arrays_of(b), path);
   return b;
 }
 
@@ -491,26 +443,8 @@ std::string file_bytes_checksum(const std::string& path, const DatasetLocation& 
 std::vector<DatasetVerification> verify_bundle_checksums(const std::string& path) {
   h5::File file = h5::open_file(path);
   std::vector<DatasetVerification> out;
-  for (const char* name : {ds::q0,
-                           ds::qf,
-                           ds::duration,
-                           ds::command_duration,
-                           ds::attempt,
-                           ds::knot_offset,
-                           ds::sample_offset,
-                           ds::knots,
-                           ds::sample_q,
-                           ds::sample_dq,
-                           ds::pert_done,
-                           ds::pert_valid,
-                           ds::pert_lazy,
-                           ds::pert_collision,
-                           ds::pert_max_error,
-                           ds::p_lazy_prop,
-                           ds::p_collision,
-                           ds::transfer_lazy,
-                           ds::transfer_max_error,
-                           ds::p_lazy_prop_transfer}) {
+  for (const BundleDatasetSpec& spec : bundle_datasets()) {
+    const char* name = spec.path;
     if (!h5::exists(file, name)) continue;  // optional ones; a missing required one: read_bundle
     DatasetVerification v;
     v.dataset = name;

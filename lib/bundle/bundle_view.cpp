@@ -35,13 +35,22 @@ std::string stored_checksums(const std::string& path, long file,
   return out;
 }
 
+// Rows of a (rows x dof) dataset ("K x dof"): the row count is free.
+uint64_t rows_by_dof(const std::string& path, long file, const char* name, uint64_t dof,
+                     const char* rows) {
+  const std::vector<uint64_t> shape = h5::dataset_shape(path, file, name);
+  if (shape.size() != 2 || shape[1] != dof)
+    fail(path, std::string(name) + ": expected " + rows + " x dof");
+  return shape[0];
+}
+
 }  // namespace
 
 CommandProfile BundleView::command(size_t e) const {
   const int n = dof();
-  return CommandProfile{knots_ + knot_offset_[e] * n,
-                        static_cast<int>(knot_offset_[e + 1] - knot_offset_[e]), n,
-                        command_duration_[e]};
+  const uint64_t* offset = arrays_.of<uint64_t>(Id::KnotOffset);
+  return CommandProfile{f64(Id::Knots) + offset[e] * n, static_cast<int>(offset[e + 1] - offset[e]),
+                        n, f64(Id::CommandDuration)[e]};
 }
 
 template <typename T>
@@ -75,6 +84,42 @@ const T* BundleView::attach(long file, const std::string& dataset,
   return data->data();
 }
 
+bool BundleView::holds(const BundleDatasetSpec& spec) const {
+  switch (spec.presence) {
+    case Presence::Always:
+      return true;
+    case Presence::Perturbation:
+      return has_perturbation_;
+    case Presence::Transfer:
+      return has_transfer_;
+  }
+  return false;
+}
+
+void BundleView::attach_datasets(long file, const BundleRows& rows, bool allow_mmap) {
+  arrays_.edges = rows.edges;
+  arrays_.dof = static_cast<uint64_t>(dof());
+  arrays_.knot_rows = rows.knots;
+  arrays_.sample_rows = rows.samples;
+  for (const BundleDatasetSpec& spec : bundle_datasets()) {
+    if (!spec.viewed || !holds(spec)) continue;
+    const std::vector<uint64_t> dims = dataset_shape(spec, rows, arrays_.dof);
+    const void* data = nullptr;
+    switch (spec.type) {
+      case ElementType::F64:
+        data = attach<double>(file, spec.path, dims, allow_mmap);
+        break;
+      case ElementType::U64:
+        data = attach<uint64_t>(file, spec.path, dims, allow_mmap);
+        break;
+      case ElementType::F32:
+        data = attach<float>(file, spec.path, dims, allow_mmap);
+        break;
+    }
+    arrays_.set(spec.id, data);
+  }
+}
+
 BundleView BundleView::open(const std::string& path, bool allow_mmap) {
   BundleView v;
   v.path_ = path;
@@ -100,41 +145,24 @@ BundleView BundleView::open(const std::string& path, bool allow_mmap) {
   v.all_mapped_ = v.map_ != nullptr;
 
   h5::File file = h5::open_file(path);
-  v.q0_ = v.attach<double>(file, ds::q0, {n, dof}, allow_mmap);
-  v.qf_ = v.attach<double>(file, ds::qf, {n, dof}, allow_mmap);
   v.states_checksum_ = stored_checksums(path, file, {ds::q0, ds::qf});
-  v.duration_ = v.attach<double>(file, ds::duration, {n}, allow_mmap);
-  v.command_duration_ = v.attach<double>(file, ds::command_duration, {n}, allow_mmap);
-  v.knot_offset_ = v.attach<uint64_t>(file, ds::knot_offset, {n + 1}, allow_mmap);
-  const std::vector<uint64_t> knot_shape = h5::dataset_shape(path, file, ds::knots);
-  if (knot_shape.size() != 2 || knot_shape[1] != dof)
-    fail(path, std::string(ds::knots) + ": expected K x dof");
-  v.knots_ = v.attach<double>(file, ds::knots, knot_shape, allow_mmap);
+  BundleRows rows{n, 0, 0};
+  rows.knots = rows_by_dof(path, file, ds::knots, dof, "K");
   // The sample offsets are checked like every reader checks them (the samples' values are
   // never used to plan: read_bundle and --verify check them; the workspace index reads them).
-  const std::vector<uint64_t> sample_shape = h5::dataset_shape(path, file, ds::sample_q);
-  if (sample_shape.size() != 2 || sample_shape[1] != dof)
-    fail(path, std::string(ds::sample_q) + ": expected S x dof");
-  const uint64_t sample_rows = sample_shape[0];
-  v.sample_offset_ = v.attach<uint64_t>(file, ds::sample_offset, {n + 1}, allow_mmap);
-  v.sample_q_ = v.attach<float>(file, ds::sample_q, sample_shape, allow_mmap);
-  v.check_knot_ranges(knot_shape[0]);
+  rows.samples = rows_by_dof(path, file, ds::sample_q, dof, "S");
   if (h5::exists(file, ds::perturbation)) {
     h5::Group g(H5Gopen2(file, ds::perturbation, H5P_DEFAULT));
     if (!g.valid()) fail(path, std::string(ds::perturbation) + ": cannot open group");
     if (v.use_perturbation(h5::read_attr_bool(path, g, "complete"))) {
       v.perturbation_theta_ = h5::read_attr_f64(path, g, "theta");
-      v.p_lazy_prop_ = v.attach<double>(file, ds::p_lazy_prop, {n}, allow_mmap);
-      v.p_collision_ = v.attach<double>(file, ds::p_collision, {n}, allow_mmap);
       // Optional: absent from analyses written before the transfer statistics.
-      if (has_transfer_datasets(path, file)) {
-        v.p_lazy_prop_transfer_ = v.attach<double>(file, ds::p_lazy_prop_transfer, {n}, allow_mmap);
-        v.transfer_max_error_ = v.attach<double>(file, ds::transfer_max_error, {n}, allow_mmap);
-        v.has_transfer_ = true;
-      }
+      v.has_transfer_ = has_transfer_datasets(path, file);
     }
   }
-  v.check_values(knot_shape[0], sample_rows, v.sample_offset_);
+  v.attach_datasets(file, rows, allow_mmap);
+  v.check_knot_ranges();
+  v.check_values();
   return v;
 }
 
@@ -148,61 +176,38 @@ BundleView BundleView::from_memory(std::shared_ptr<const Bundle> bundle, std::st
   v.header_ = b.header;
   v.edges_ = b.size();
   v.owned_.push_back(bundle);
-  v.q0_ = b.q0.data();
-  v.qf_ = b.qf.data();
-  v.duration_ = b.duration.data();
-  v.command_duration_ = b.command_duration.data();
-  v.knot_offset_ = b.knot_offset.data();
-  v.knots_ = b.knots.data();
-  v.sample_offset_ = b.sample_offset.data();
-  v.sample_q_ = b.sample_q.data();
-  v.check_knot_ranges(b.knots.size() / static_cast<size_t>(b.dof()));
   const Perturbation& p = b.perturbation;
   if (p.present && v.use_perturbation(p.complete)) {
     v.perturbation_theta_ = p.theta;
-    v.p_lazy_prop_ = p.p_lazy_prop.data();
-    v.p_collision_ = p.p_collision.data();
-    if (p.has_transfer) {
-      v.p_lazy_prop_transfer_ = p.p_lazy_prop_transfer.data();
-      v.transfer_max_error_ = p.transfer_max_error.data();
-      v.has_transfer_ = true;
-    }
+    v.has_transfer_ = p.has_transfer;
   }
-  // After the perturbation is attached, so that its values are checked too (as open does).
-  v.check_values(b.knots.size() / static_cast<size_t>(b.dof()),
-                 b.sample_q.size() / static_cast<size_t>(b.dof()), b.sample_offset.data());
+  const BundleArrays all = arrays_of(b);
+  v.arrays_ = all;
+  v.arrays_.data = {};
+  for (const BundleDatasetSpec& spec : bundle_datasets())
+    if (spec.viewed && v.holds(spec))
+      v.arrays_.set(spec.id, all.data[static_cast<size_t>(spec.id)]);
+  v.check_knot_ranges();
+  v.check_values();
   return v;
 }
 
 // The offsets index the knots: check them once so that no query can read out of bounds.
-void BundleView::check_knot_ranges(uint64_t knot_rows) const {
+void BundleView::check_knot_ranges() const {
+  const uint64_t* offset = arrays_.of<uint64_t>(Id::KnotOffset);
   for (uint64_t e = 0; e < edges_; ++e) {
-    if (knot_offset_[e + 1] < knot_offset_[e] + 2 || knot_offset_[e + 1] > knot_rows) {
+    if (offset[e + 1] < offset[e] + 2 || offset[e + 1] > arrays_.knot_rows) {
       fail(path_,
            std::string(ds::knot_offset) + ": edge " + std::to_string(e) + " has a bad knot range");
     }
   }
 }
 
-// The checks every reader runs (bundle_check.h) on what the view reads, in one pass.
-void BundleView::check_values(uint64_t knot_rows, uint64_t sample_rows,
-                              const uint64_t* sample_offset) const {
-  BundleArrays a;
-  a.edges = edges_;
-  a.dof = static_cast<uint64_t>(dof());
-  a.knot_rows = knot_rows;
-  a.sample_rows = sample_rows;
-  a.q0 = q0_;
-  a.qf = qf_;
-  a.duration = duration_;
-  a.command_duration = command_duration_;
-  a.knot_offset = knot_offset_;
-  a.sample_offset = sample_offset;
-  a.knots = knots_;
-  a.p_lazy_prop = p_lazy_prop_;
-  a.p_collision = p_collision_;
-  a.p_lazy_prop_transfer = p_lazy_prop_transfer_;
-  a.transfer_max_error = transfer_max_error_;
+// The checks every reader runs (bundle_check.h) on what the view reads, in one pass; not the
+// samples' values, which planning never uses.
+void BundleView::check_values() const {
+  BundleArrays a = arrays_;
+  a.set(Id::SampleQ, nullptr);
   check_bundle_arrays(a, path_);
   if (has_perturbation_ && !(perturbation_theta_ > 0 && perturbation_theta_ <= 1e3))
     fail(path_, std::string(ds::perturbation) + ": attribute theta: " +

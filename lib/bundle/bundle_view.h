@@ -12,6 +12,8 @@
 #include <vector>
 
 #include "lazyboe/bundle/bundle.h"
+#include "lazyboe/bundle/bundle_check.h"
+#include "lazyboe/bundle/bundle_format.h"
 #include "lazyboe/sim/command_profile.h"
 
 namespace lazyboe {
@@ -36,34 +38,39 @@ class BundleView {
   size_t size() const { return edges_; }
   int dof() const { return header_.dof; }
 
-  const double* q0(size_t edge) const { return q0_ + edge * dof(); }
-  const double* qf(size_t edge) const { return qf_ + edge * dof(); }
-  double duration(size_t edge) const { return duration_[edge]; }
+  const double* q0(size_t edge) const { return f64(Id::Q0) + edge * dof(); }
+  const double* qf(size_t edge) const { return f64(Id::Qf) + edge * dof(); }
+  double duration(size_t edge) const { return f64(Id::Duration)[edge]; }
   CommandProfile command(size_t edge) const;
 
   bool has_perturbation() const { return has_perturbation_; }
   double perturbation_theta() const { return perturbation_theta_; }
-  double p_lazy_prop(size_t edge) const { return p_lazy_prop_[edge]; }
-  double p_collision(size_t edge) const { return p_collision_[edge]; }
+  double p_lazy_prop(size_t edge) const { return f64(Id::PLazyProp)[edge]; }
+  double p_collision(size_t edge) const { return f64(Id::PCollision)[edge]; }
   // The transfer statistics of the analysis (lazyboe-perturb since they exist): false for an
   // analysis written before them, or without a (finished) analysis.
   bool has_transfer() const { return has_transfer_; }
-  double p_lazy_prop_transfer(size_t edge) const { return p_lazy_prop_transfer_[edge]; }
-  double transfer_max_error(size_t edge) const { return transfer_max_error_[edge]; }
+  double p_lazy_prop_transfer(size_t edge) const { return f64(Id::PLazyPropTransfer)[edge]; }
+  double transfer_max_error(size_t edge) const { return f64(Id::TransferMaxError)[edge]; }
 
   // The per-edge arrays themselves (size() values each), for zero-copy views (the Python
   // module); null when the bundle has none (no analysis, or no transfer statistics).
-  const double* duration_data() const { return duration_; }
-  const double* command_duration_data() const { return command_duration_; }
-  const double* p_lazy_prop_data() const { return p_lazy_prop_; }
-  const double* p_collision_data() const { return p_collision_; }
-  const double* p_lazy_prop_transfer_data() const { return p_lazy_prop_transfer_; }
-  const double* transfer_max_error_data() const { return transfer_max_error_; }
+  const double* duration_data() const { return f64(Id::Duration); }
+  const double* command_duration_data() const { return f64(Id::CommandDuration); }
+  const double* p_lazy_prop_data() const { return f64(Id::PLazyProp); }
+  const double* p_collision_data() const { return f64(Id::PCollision); }
+  const double* p_lazy_prop_transfer_data() const { return f64(Id::PLazyPropTransfer); }
+  const double* transfer_max_error_data() const { return f64(Id::TransferMaxError); }
 
   // The stored trajectory samples of an edge: sample_count(edge) rows of dof floats, the states
   // every sample_interval of the header and the end state (none when it is 0).
-  size_t sample_count(size_t edge) const { return sample_offset_[edge + 1] - sample_offset_[edge]; }
-  const float* samples(size_t edge) const { return sample_q_ + sample_offset_[edge] * dof(); }
+  size_t sample_count(size_t edge) const {
+    const uint64_t* offset = arrays_.of<uint64_t>(Id::SampleOffset);
+    return offset[edge + 1] - offset[edge];
+  }
+  const float* samples(size_t edge) const {
+    return arrays_.of<float>(Id::SampleQ) + arrays_.of<uint64_t>(Id::SampleOffset)[edge] * dof();
+  }
 
   bool memory_mapped() const { return all_mapped_; }  // every dataset mapped
   // The checksums stored with the q0 and qf datasets, "<q0> <qf>": what ties an index file
@@ -73,13 +80,17 @@ class BundleView {
   const std::vector<std::string>& warnings() const { return warnings_; }
 
  private:
+  using Id = BundleDatasetId;
   BundleView() = default;
+  const double* f64(Id id) const { return arrays_.of<double>(id); }
   template <typename T>
   const T* attach(long file, const std::string& dataset, const std::vector<uint64_t>& dims,
                   bool allow_mmap);
+  void attach_datasets(long file, const BundleRows& rows, bool allow_mmap);
+  bool holds(const BundleDatasetSpec& spec) const;  // the view has the dataset's group
   // What both ways of making a view check and decide once the arrays are attached.
-  void check_knot_ranges(uint64_t knot_rows) const;
-  void check_values(uint64_t knot_rows, uint64_t sample_rows, const uint64_t* sample_offset) const;
+  void check_knot_ranges() const;
+  void check_values() const;
   bool use_perturbation(bool complete);
 
   std::string path_;
@@ -93,18 +104,8 @@ class BundleView {
   std::vector<std::string> warnings_;
   std::string states_checksum_;
 
-  const double* q0_ = nullptr;
-  const double* qf_ = nullptr;
-  const double* duration_ = nullptr;
-  const double* command_duration_ = nullptr;
-  const uint64_t* knot_offset_ = nullptr;
-  const double* knots_ = nullptr;
-  const uint64_t* sample_offset_ = nullptr;
-  const float* sample_q_ = nullptr;
-  const double* p_lazy_prop_ = nullptr;
-  const double* p_collision_ = nullptr;
-  const double* p_lazy_prop_transfer_ = nullptr;
-  const double* transfer_max_error_ = nullptr;
+  // The viewed datasets (the table's `viewed` ones the file has), mapped or owned.
+  BundleArrays arrays_;
   bool has_transfer_ = false;
   double perturbation_theta_ = 0;
   bool has_perturbation_ = false;
