@@ -17,6 +17,7 @@
 #include "lazyboe/collision/environment.h"
 #include "lazyboe/robot/dynamics.h"
 #include "lazyboe/robot/kinematics.h"
+#include "lazyboe/robot/robot_config.h"
 #include "lazyboe/robot/robot_model.h"
 #include "lazyboe/sim/rollout_pool.h"
 #include "lazyboe/sim/simulator.h"

@@ -11,6 +11,7 @@
 #include "lazyboe/collision/environment.h"
 #include "lazyboe/planning/world.h"
 #include "lazyboe/robot/kinematics.h"
+#include "lazyboe/robot/robot_config.h"
 
 namespace {
 

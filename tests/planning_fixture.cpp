@@ -11,6 +11,7 @@
 #include "lazyboe/bundle/perturbation.h"
 #include "lazyboe/common/error.h"
 #include "lazyboe/planning/registry.h"
+#include "lazyboe/robot/robot_config.h"
 
 namespace lazyboe::test {
 

@@ -10,6 +10,7 @@
 #include "lazyboe/collision/allowed_pairs.h"
 #include "lazyboe/collision/collision_model.h"
 #include "lazyboe/common/error.h"
+#include "lazyboe/robot/robot_config.h"
 #include "test_util.h"
 
 namespace lazyboe {

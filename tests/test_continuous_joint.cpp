@@ -11,6 +11,7 @@
 #include "lazyboe/collision/environment.h"
 #include "lazyboe/common/error.h"
 #include "lazyboe/planning/request.h"
+#include "lazyboe/robot/robot_config.h"
 #include "lazyboe/robot/robot_model.h"
 #include "lazyboe/sim/trajectory_check.h"
 #include "test_util.h"

@@ -13,6 +13,7 @@
 
 #include "alloc_counter.h"
 #include "lazyboe/robot/dynamics.h"
+#include "lazyboe/robot/robot_config.h"
 #include "test_util.h"
 
 namespace lazyboe {

@@ -18,6 +18,7 @@
 #include "lazyboe/collision/environment.h"
 #include "lazyboe/common/error.h"
 #include "lazyboe/robot/kinematics.h"
+#include "lazyboe/robot/robot_config.h"
 #include "lazyboe/robot/robot_model.h"
 #include "test_util.h"
 

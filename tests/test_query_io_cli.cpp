@@ -23,6 +23,7 @@
 #include "lazyboe/bundle/bundle_view.h"
 #include "lazyboe/collision/environment.h"
 #include "lazyboe/common/error.h"
+#include "lazyboe/robot/robot_config.h"
 #include "lazyboe/sim/simulator.h"
 #include "planning_fixture.h"
 #include "query_cli_util.h"

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "lazyboe/common/error.h"
+#include "lazyboe/robot/robot_config.h"
 #include "lazyboe/robot/robot_model.h"
 #include "test_util.h"
 

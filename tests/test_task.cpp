@@ -30,6 +30,7 @@
 #include "lazyboe/robot/dynamics.h"
 #include "lazyboe/robot/inverse_kinematics.h"
 #include "lazyboe/robot/payload.h"
+#include "lazyboe/robot/robot_config.h"
 #include "lazyboe/sim/random.h"
 #include "lazyboe/sim/trajectory_check.h"
 #include "planning_fixture.h"

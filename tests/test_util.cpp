@@ -12,6 +12,7 @@
 
 #include "lazyboe/common/error.h"
 #include "lazyboe/common/hash.h"
+#include "lazyboe/robot/robot_config.h"
 
 namespace lazyboe::test {
 

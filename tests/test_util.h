@@ -5,6 +5,7 @@
 
 #include "lazyboe/bundle/bundle.h"
 #include "lazyboe/collision/collision_model.h"
+#include "lazyboe/robot/robot_config.h"
 #include "lazyboe/robot/robot_model.h"
 #include "lazyboe/sim/simulator.h"
 

@@ -13,6 +13,7 @@
 
 #include "lazyboe/bench/report.h"
 #include "lazyboe/common/atomic_file.h"
+#include "lazyboe/common/data_dir.h"
 #include "lazyboe/common/json_fields.h"
 #include "lazyboe/planning/ompl/ompl_planners.h"
 #include "lazyboe/planning/planning_session.h"

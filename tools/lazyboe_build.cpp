@@ -19,6 +19,7 @@
 #include "lazyboe/io/bundle_report.h"
 #include "lazyboe/planning/edge_index_file.h"
 #include "lazyboe/planning/workspace_index.h"
+#include "lazyboe/robot/robot_config.h"
 #include "mpi_build.h"
 #include "mpi_offline.h"
 #include "tool_main.h"

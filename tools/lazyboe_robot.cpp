@@ -18,6 +18,7 @@
 #include "lazyboe/robot/dynamics.h"
 #include "lazyboe/robot/payload.h"
 #include "lazyboe/robot/resource_path.h"
+#include "lazyboe/robot/robot_config.h"
 #include "lazyboe/sim/robot_setup.h"
 #include "lazyboe/sim/trajectory_check.h"
 #include "tool_main.h"

@@ -6,6 +6,7 @@
 #include "lazyboe/bundle/scene.h"
 #include "lazyboe/common/atomic_file.h"
 #include "lazyboe/common/file_checks.h"
+#include "lazyboe/robot/robot_config.h"
 #include "lazyboe/view/view_data.h"
 #include "lazyboe/view/view_page.h"
 #include "tool_main.h"

@@ -16,6 +16,7 @@
 #include "lazyboe/collision/collision_model.h"
 #include "lazyboe/common/bytes.h"
 #include "lazyboe/common/journal.h"
+#include "lazyboe/robot/robot_config.h"
 #include "mpi_offline.h"
 
 namespace lazyboe::mpi {

@@ -6,6 +6,7 @@
 
 #include "lazyboe/common/error.h"
 #include "lazyboe/common/hash.h"
+#include "lazyboe/robot/robot_config.h"
 
 namespace lazyboe {
 

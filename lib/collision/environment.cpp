@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <set>
 
+#include "lazyboe/common/data_dir.h"
 #include "lazyboe/common/error.h"
 #include "lazyboe/common/file_checks.h"
 #include "lazyboe/common/hash.h"

@@ -7,6 +7,7 @@
 #include "lazyboe/common/numbers.h"
 #include "lazyboe/common/text.h"
 #include "lazyboe/io/csv.h"
+#include "lazyboe/robot/robot_config.h"
 
 namespace lazyboe {
 namespace {

@@ -1,10 +1,9 @@
 // The robot description: a serial chain read from a URDF plus a robot config file (JSON) that
-// adds what URDF cannot hold. Built once, then read-only and shared by every thread; per-thread
-// scratch lives in RobotData (kinematics.h).
+// adds what URDF cannot hold (read by robot_config.h's load_robot). Built once, then read-only
+// and shared by every thread; per-thread scratch lives in RobotData (kinematics.h).
 #pragma once
 
 #include <memory>
-#include <nlohmann/json_fwd.hpp>
 #include <string>
 #include <utility>
 #include <vector>
@@ -150,30 +149,5 @@ struct RobotModel {
   int tip_link() const { return static_cast<int>(links.size()) - 1; }
   bool is_allowed_pair(int link_a, int link_b) const;
 };
-
-class JsonField;
-// The link an object's "link" member names (default: the tip link); throws Error naming the
-// field for an unknown one (unknown_link's text).
-int link_field(const JsonField& object, const RobotModel& robot);
-
-// Loads a robot config (JSON; or a bundled robot by name: "panda", "ur5") and the URDF it
-// points at. Throws Error naming the file and field for anything missing, malformed or not
-// physical.
-RobotModel load_robot(const std::string& config_path);
-// The same for a config held in memory; `config_path` names it in errors and is where its
-// relative paths (urdf, package_path) start.
-RobotModel robot_from_json(const nlohmann::json& config, const std::string& config_path);
-
-// The moving joints (limits as the URDF gives them) of the chain from `base_link` to
-// `tip_link` (empty: the defaults of the config's fields), for writing a config.
-std::vector<Joint> chain_joints(const std::string& urdf_path, const std::string& base_link,
-                                const std::string& tip_link);
-
-// The bundled data directory (robots, scenes, sample queries): LAZYBOE_DATA_DIR in the
-// environment; else an installed copy beside the running tool or Python module
-// (<prefix>/share/lazyboe); else the source tree's data/ (a build tree); else the install
-// prefix's share/lazyboe (a program of the user's linked with the installed library).
-std::string data_dir();
-std::string default_robot_path();
 
 }  // namespace lazyboe

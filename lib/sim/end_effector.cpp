@@ -5,6 +5,7 @@
 
 #include "lazyboe/common/json_fields.h"
 #include "lazyboe/common/numbers.h"
+#include "lazyboe/robot/robot_config.h"
 
 namespace lazyboe {
 

@@ -8,6 +8,7 @@
 #include "lazyboe/collision/allowed_pairs.h"
 #include "lazyboe/common/error.h"
 #include "lazyboe/robot/dynamics.h"
+#include "lazyboe/robot/robot_config.h"
 #include "lazyboe/robot/srdf.h"
 #include "lazyboe/sim/random.h"
 

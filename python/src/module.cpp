@@ -1,6 +1,7 @@
 // The extension module lazyboe._lazyboe; the package lazyboe re-exports it (docs/python.md).
 #include "convert.h"
 #include "lazyboe/common/version.h"
+#include "lazyboe/robot/robot_config.h"
 #include "lazyboe/robot/robot_model.h"
 
 namespace lazyboe::python {

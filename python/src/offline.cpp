@@ -18,6 +18,7 @@
 #include "lazyboe/bundle/settings.h"
 #include "lazyboe/common/version.h"
 #include "lazyboe/planning/edge_index_file.h"
+#include "lazyboe/robot/robot_config.h"
 
 namespace lazyboe::python {
 namespace {

@@ -3,6 +3,7 @@
 #include "fuzz_util.h"
 #include "lazyboe/collision/environment.h"
 #include "lazyboe/common/error.h"
+#include "lazyboe/robot/robot_config.h"
 #include "lazyboe/robot/robot_model.h"
 
 using namespace lazyboe;

@@ -5,6 +5,7 @@
 #include "lazyboe/collision/environment.h"
 #include "lazyboe/common/error.h"
 #include "lazyboe/io/trajectory_csv.h"
+#include "lazyboe/robot/robot_config.h"
 #include "lazyboe/robot/robot_model.h"
 #include "lazyboe/sim/trajectory_check.h"
 
