@@ -206,8 +206,8 @@ const EdgePool& edge_pool() {
     const RobotModel& m = robot();
     static const CollisionModel model = table_scene().model;
     BuildSettings settings;
-    settings.region_lower = m.region_lower;
-    settings.region_upper = m.region_upper;
+    settings.region_lower = m.region.lower;
+    settings.region_upper = m.region.upper;
     settings.seed = kSeed;
     settings.simulation.integrator = Integrator::SemiImplicitEuler;  // lazyboe-build's default
     EdgePool p{Simulator(m, model, settings.simulation), {}};

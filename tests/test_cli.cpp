@@ -161,8 +161,8 @@ TEST(Cli, InfoNamesJointsAndCollisionBodies) {
   for (int i = 1; i <= 7; ++i) {
     EXPECT_NE(r.out.find("panda_joint" + std::to_string(i)), std::string::npos) << r.out;
   }
-  ASSERT_FALSE(panda().collision_bodies.empty());
-  for (const CollisionBody& c : panda().collision_bodies) {
+  ASSERT_FALSE(panda().geometry.bodies.empty());
+  for (const CollisionBody& c : panda().geometry.bodies) {
     EXPECT_NE(r.out.find(c.name), std::string::npos) << c.name << "\n" << r.out;
   }
   EXPECT_NE(r.out.find("collision bodies"), std::string::npos) << r.out;
@@ -182,15 +182,15 @@ TEST(Cli, InfoJsonParsesWithSevenDof) {
   for (int i = 0; i < 7; ++i) {
     EXPECT_EQ(j["joints"][i].at("name").get<std::string>(), "panda_joint" + std::to_string(i + 1));
   }
-  ASSERT_EQ(j.at("collision_bodies").size(), panda().collision_bodies.size());
-  for (size_t i = 0; i < panda().collision_bodies.size(); ++i) {
+  ASSERT_EQ(j.at("collision_bodies").size(), panda().geometry.bodies.size());
+  for (size_t i = 0; i < panda().geometry.bodies.size(); ++i) {
     EXPECT_EQ(j["collision_bodies"][i].at("name").get<std::string>(),
-              panda().collision_bodies[i].name);
+              panda().geometry.bodies[i].name);
   }
   EXPECT_DOUBLE_EQ(j["joints"][3].at("lower").get<double>(), -3.0718);
   EXPECT_DOUBLE_EQ(j["joints"][3].at("upper").get<double>(), -0.0698);
   EXPECT_EQ(j.at("tip_link").get<std::string>(), "panda_link8");
-  EXPECT_EQ(j["sampling_region"]["lower"][1].get<double>(), panda().region_lower[1]);
+  EXPECT_EQ(j["sampling_region"]["lower"][1].get<double>(), panda().region.lower[1]);
   EXPECT_EQ(j["controller"]["kv"].size(), 7u);
 }
 
@@ -358,7 +358,7 @@ TEST(Cli, CheckReportsLimitsSelfAndEnvironmentCollision) {
   EXPECT_EQ(rows[3][1], 1);
   EXPECT_EQ(rows[3][2], 0);
   EXPECT_GE(rows[3][3], 0);
-  EXPECT_LT(rows[3][3], robot.collision_margin);
+  EXPECT_LT(rows[3][3], robot.geometry.margin);
 
   // Distances agree with the library.
   const CollisionModel cm = build_collision_model(robot, env);

@@ -101,7 +101,8 @@ TEST(Collision, AdjacentLinksOverlapButAreExcluded) {
   ASSERT_GE(l2, 0);
   EXPECT_TRUE(self_pair_collides(unfiltered.model, unfiltered.cd, l1, l2));
   for (const auto& [a, b] : normal.model.self_pairs) {
-    EXPECT_FALSE(robot.is_allowed_pair(normal.model.robot[a].link, normal.model.robot[b].link));
+    EXPECT_FALSE(
+        robot.geometry.is_allowed_pair(normal.model.robot[a].link, normal.model.robot[b].link));
   }
 }
 
@@ -143,7 +144,7 @@ TEST(Collision, NearTouchingRespectsTheMargin) {
   ASSERT_GE(s, 0);
   const Eigen::Isometry3d& t = probe.cd.transform[s];
   const double capsule_radius = 0.04, sphere_radius = 0.01;
-  const double margin = robot.collision_margin;
+  const double margin = robot.geometry.margin;
   ASSERT_GT(margin, 0.002);
   for (double d : {0.0005, margin - 1e-3, margin - 1e-4, margin + 1e-4, margin + 3e-3}) {
     Environment env;
@@ -255,7 +256,7 @@ TEST(Collision, TheDocsDataPathsWorkFromAnyFolder) {
 // Robots too: `--robot ur5` is the bundled config; an unknown name lists the bundled robots.
 TEST(Collision, BundledRobotsByName) {
   const RobotModel ur5 = load_robot("ur5");
-  EXPECT_EQ(std::filesystem::path(ur5.config_path).filename(), "ur5.json");
+  EXPECT_EQ(std::filesystem::path(ur5.files.config).filename(), "ur5.json");
   EXPECT_EQ(ur5.dof, 6);
   if (std::filesystem::exists("no-such-robot")) return;  // a file of that name here
   try {
@@ -288,7 +289,7 @@ TEST(Collision, DerivedAllowedPairsAreAdjacentLinks) {
   // Every derived pair is in the committed config.
   for (const LinkPairStats& p : result.pairs) {
     if (!p.reason.empty()) {
-      EXPECT_TRUE(robot.is_allowed_pair(p.link_a, p.link_b));
+      EXPECT_TRUE(robot.geometry.is_allowed_pair(p.link_a, p.link_b));
     }
   }
 }

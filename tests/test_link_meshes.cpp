@@ -125,9 +125,9 @@ std::vector<Outcome> sweep(const RobotModel& robot, int n) {
 
 TEST(LinkMeshes, StlColladaAndObjLoadUnderPackageUrisAsFittedCapsules) {
   const RobotModel robot = load("fitted", kMeshUrdf, config("fitted.urdf", kPackagePath));
-  ASSERT_EQ(robot.collision_bodies.size(), 3u);
-  ASSERT_EQ(robot.resource_files.size(), 3u);
-  for (const CollisionBody& b : robot.collision_bodies) {
+  ASSERT_EQ(robot.geometry.bodies.size(), 3u);
+  ASSERT_EQ(robot.files.resources.size(), 3u);
+  for (const CollisionBody& b : robot.geometry.bodies) {
     EXPECT_EQ(b.representation, MeshRepresentation::Fitted) << b.name;
     EXPECT_EQ(b.shape.type, ShapeType::Capsule) << b.name;
     EXPECT_TRUE(std::filesystem::exists(b.mesh_file)) << b.mesh_file;
@@ -136,7 +136,7 @@ TEST(LinkMeshes, StlColladaAndObjLoadUnderPackageUrisAsFittedCapsules) {
     EXPECT_LT(b.over_approximation, 0.06) << b.name;
   }
   // The COLLADA file is Z_UP: read as written, its long side stays along x.
-  const CollisionBody& fore = robot.collision_bodies[2];
+  const CollisionBody& fore = robot.geometry.bodies[2];
   EXPECT_NEAR(std::abs(fore.in_link.R.col(2).x()), 1.0, 1e-6);
   EXPECT_NEAR(fore.in_link.p.x(), 0.15, 1e-6);
 }
@@ -144,8 +144,8 @@ TEST(LinkMeshes, StlColladaAndObjLoadUnderPackageUrisAsFittedCapsules) {
 TEST(LinkMeshes, AFittedCapsuleEnclosesEveryVertex) {
   const RobotModel robot = load("fitted", kMeshUrdf, config("fitted.urdf", kPackagePath));
   const double origins[3] = {0.45, 0.2, 0.15};  // the collision origins' x (post: base link)
-  for (size_t k = 0; k < robot.collision_bodies.size(); ++k) {
-    const CollisionBody& b = robot.collision_bodies[k];
+  for (size_t k = 0; k < robot.geometry.bodies.size(); ++k) {
+    const CollisionBody& b = robot.geometry.bodies[k];
     const TriangleMesh mesh = load_mesh(b.mesh_file, Eigen::Vector3d::Ones());
     const Pose origin(Eigen::Matrix3d::Identity(),
                       Eigen::Vector3d(origins[k], 0, k == 0 ? 0.1 : 0.0));
@@ -162,9 +162,9 @@ TEST(LinkMeshes, ExactAndFittedAgreeFarFromContactAndFittedIsNeverLessConservati
   const RobotModel fitted = load("fitted", kMeshUrdf, config("fitted.urdf", kPackagePath));
   const RobotModel exact =
       load("exact", kMeshUrdf, config("exact.urdf", kPackagePath, 0.005, kExact));
-  for (const CollisionBody& b : exact.collision_bodies) EXPECT_EQ(b.shape.type, ShapeType::Mesh);
+  for (const CollisionBody& b : exact.geometry.bodies) EXPECT_EQ(b.shape.type, ShapeType::Mesh);
   double reach = 0;
-  for (const CollisionBody& b : fitted.collision_bodies)
+  for (const CollisionBody& b : fitted.geometry.bodies)
     reach = std::max(reach, b.over_approximation);
   const std::vector<Outcome> f = sweep(fitted, 3000), e = sweep(exact, 3000);
   int exact_hits = 0, far = 0;
@@ -172,7 +172,7 @@ TEST(LinkMeshes, ExactAndFittedAgreeFarFromContactAndFittedIsNeverLessConservati
     if (e[k].hit) {
       EXPECT_TRUE(f[k].hit) << "configuration " << k;
     }
-    if (e[k].distance > reach + fitted.collision_margin) {
+    if (e[k].distance > reach + fitted.geometry.margin) {
       EXPECT_FALSE(f[k].hit) << "configuration " << k;
       ++far;
     }
@@ -216,7 +216,7 @@ TEST(LinkMeshes, ABoxAsAConvexHullCollidesAsTheExactMesh) {
         load("exact", kMeshUrdf, config("exact.urdf", kPackagePath, margin, kExact));
     const RobotModel hull =
         load("hull", kMeshUrdf, config("hull.urdf", kPackagePath, margin, kConvex));
-    for (const CollisionBody& b : hull.collision_bodies) {
+    for (const CollisionBody& b : hull.geometry.bodies) {
       EXPECT_TRUE(b.shape.type == ShapeType::Mesh && b.shape.convex) << b.name;
       EXPECT_EQ(b.shape.mesh->vertices.size(), 8u) << b.name;  // a box's corners
       EXPECT_EQ(b.representation, MeshRepresentation::Convex);
@@ -273,7 +273,7 @@ TEST(LinkMeshes, TheConvexHullEnclosesEveryVertexWithOutwardTriangles) {
 TEST(LinkMeshes, PackagesResolveThroughRosPackagePathFileUrisAndRelativePaths) {
   const std::string pkgs = test::temp_dir() + "/mesher/pkgs";
   ::setenv("ROS_PACKAGE_PATH", ("/nonexistent:" + pkgs).c_str(), 1);
-  EXPECT_EQ(load("fitted", kMeshUrdf, config("fitted.urdf")).resource_files.size(), 3u);
+  EXPECT_EQ(load("fitted", kMeshUrdf, config("fitted.urdf")).files.resources.size(), 3u);
   ::unsetenv("ROS_PACKAGE_PATH");
   const std::string message = test::robot_load_error(test::temp_dir() + "/mesher/fitted.json");
   EXPECT_NE(message.find("package 'meshtest'"), std::string::npos) << message;
@@ -282,7 +282,7 @@ TEST(LinkMeshes, PackagesResolveThroughRosPackagePathFileUrisAndRelativePaths) {
       urdf("<mesh filename=\"file://" + pkgs + "/meshtest/meshes/upper.stl\"/>",
            R"(<mesh filename="pkgs/meshtest/meshes/fore.dae"/>)", R"(<box size="0.05 0.05 0.2"/>)");
   const RobotModel robot = load("uris", other, config("uris.urdf"));
-  EXPECT_EQ(robot.resource_files.size(), 2u);
+  EXPECT_EQ(robot.files.resources.size(), 2u);
 }
 
 TEST(LinkMeshes, TheRobotsIdentityCoversItsMeshes) {

@@ -119,7 +119,7 @@ TEST(Perturbation, EdgeNextToAnObstacleCollidesFarEdgeDoesNot) {
     distance = min_distance(scene.collision, ws.collision).env_distance;
   }
   ASSERT_LT(distance, 0.03);
-  ASSERT_GT(distance, scene.robot.collision_margin);
+  ASSERT_GT(distance, scene.robot.geometry.margin);
   Bundle b = resting_edges(scene, {near, ready()});
   PerturbSettings s;
   s.theta = 0.1;
@@ -134,8 +134,8 @@ TEST(Perturbation, EdgeNextToAnObstacleCollidesFarEdgeDoesNot) {
 
 Bundle small_bundle(Scene& scene, size_t edges) {
   BuildSettings settings;
-  settings.region_lower = scene.robot.region_lower;
-  settings.region_upper = scene.robot.region_upper;
+  settings.region_lower = scene.robot.region.lower;
+  settings.region_upper = scene.robot.region.upper;
   settings.edges = edges;
   settings.simulation.sample_every = 0;
   Bundle b = new_bundle(scene.robot, scene.env, settings);

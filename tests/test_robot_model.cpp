@@ -28,15 +28,15 @@ TEST(RobotModel, PandaHasSevenJointsWithPublishedLimits) {
   EXPECT_EQ(robot.links.back().body, 6);  // fixed to link7's body
   EXPECT_NEAR(robot.bodies[2].mass, 3.228604, 1e-12);
   EXPECT_NEAR(robot.bodies[3].com.y(), 1.04419e-01, 1e-12);
-  EXPECT_GT(robot.collision_margin, 0.0);
+  EXPECT_GT(robot.geometry.margin, 0.0);
 }
 
 TEST(RobotModel, CylinderWithSphereCapsBecomesOneCapsule) {
   const RobotModel& robot = test::panda();
-  ASSERT_EQ(robot.collision_bodies.size(), 10u);  // Franka's ten coarse capsules
-  for (const CollisionBody& c : robot.collision_bodies)
+  ASSERT_EQ(robot.geometry.bodies.size(), 10u);  // Franka's ten coarse capsules
+  for (const CollisionBody& c : robot.geometry.bodies)
     EXPECT_EQ(c.shape.type, ShapeType::Capsule) << c.name;
-  const CollisionBody& link1 = robot.collision_bodies[1];
+  const CollisionBody& link1 = robot.geometry.bodies[1];
   EXPECT_EQ(robot.links[link1.link].name, "panda_link1");
   EXPECT_NEAR(link1.shape.radius, 0.06, 1e-12);
   EXPECT_NEAR(link1.shape.length, 0.283, 1e-12);
@@ -85,8 +85,8 @@ TEST(RobotModel, GenericChainWithPrismaticJointAndFixedSensor) {
   // The sensor's mass joins link c's body: 1.5 kg with the centre of mass pulled up.
   EXPECT_NEAR(robot.bodies[2].mass, 1.5, 1e-12);
   EXPECT_NEAR(robot.bodies[2].com.z(), 0.5 * 0.22 / 1.5, 1e-12);
-  EXPECT_EQ(robot.collision_bodies.size(), 2u);
-  EXPECT_TRUE(robot.is_allowed_pair(robot.link_index("a"), robot.link_index("c")));
+  EXPECT_EQ(robot.geometry.bodies.size(), 2u);
+  EXPECT_TRUE(robot.geometry.is_allowed_pair(robot.link_index("a"), robot.link_index("c")));
 }
 
 TEST(RobotModel, BranchingUrdfNeedsATipLink) {

@@ -21,8 +21,8 @@ using test::Scene;
 
 BuildSettings default_settings(const RobotModel& robot) {
   BuildSettings s;
-  s.region_lower = robot.region_lower;
-  s.region_upper = robot.region_upper;
+  s.region_lower = robot.region.lower;
+  s.region_upper = robot.region.upper;
   return s;
 }
 

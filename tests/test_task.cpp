@@ -153,7 +153,7 @@ TEST(Payload, ThreeKilogramsBreakCommandsThatPassEmpty) {
   std::vector<double> knots;
   for (int trial = 0; trial < 4000 && torque == 0; ++trial) {
     for (int i = 0; i < q.size(); ++i)
-      q[i] = rng.uniform(f.robot.region_lower[i], f.robot.region_upper[i]);
+      q[i] = rng.uniform(f.robot.region.lower[i], f.robot.region.upper[i]);
     if (check_state(f.sim, ws, q) != RolloutStatus::Valid) continue;
     const double duration = sample_command_profile(f.robot, family, rng, knots);
     const CommandProfile c{knots.data(), static_cast<int>(knots.size()) / f.robot.dof, f.robot.dof,
@@ -501,8 +501,8 @@ TEST(PoseGoal, InverseKinematicsReachesPosesOfTheRegion) {
   for (int trial = 0; trial < 20; ++trial) {
     JointVector target(7), q(7);
     for (int i = 0; i < 7; ++i) {
-      target[i] = rng.uniform(f.robot.region_lower[i], f.robot.region_upper[i]);
-      q[i] = rng.uniform(f.robot.region_lower[i], f.robot.region_upper[i]);
+      target[i] = rng.uniform(f.robot.region.lower[i], f.robot.region.upper[i]);
+      q[i] = rng.uniform(f.robot.region.lower[i], f.robot.region.upper[i]);
     }
     const Goal g = pose_goal(f.robot, target);
     if (!solve_ik(f.robot, d, g.pose_target(), q)) continue;

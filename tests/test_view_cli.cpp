@@ -133,7 +133,7 @@ TEST(ViewCli, PageCarriesTrajectoriesFailuresAndTheirQueries) {
   EXPECT_EQ(res["failures"][1]["kind"], "error");
   // The robot's chain as the library has it, and the bundled table's obstacles.
   EXPECT_EQ(d["robot"]["joints"].size(), 7u);
-  EXPECT_EQ(d["robot"]["shapes"].size(), panda().collision_bodies.size());
+  EXPECT_EQ(d["robot"]["shapes"].size(), panda().geometry.bodies.size());
   EXPECT_GT(d["environment"]["obstacles"].size(), 0u);
 }
 

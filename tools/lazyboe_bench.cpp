@@ -345,7 +345,7 @@ StudyInfo study_info(const BenchOptions& o, const PlanningSession& session,
     info.task += (info.task.empty() ? "" : ", ") + ("end-effector limits " + o.end_effector_limits);
   info.bundle = o.bundle_path;
   info.edges = session.bundle.size();
-  info.robot = session.robot.config_path;
+  info.robot = session.robot.files.config;
   info.environment = world.env.path;
   info.problems = static_cast<int>(problems.size());
   info.problems_source = problems_source;

@@ -34,8 +34,8 @@ void parse_region(const std::string& text, const RobotModel& robot, JointVector&
                   JointVector& upper) {
   const int n = robot.dof;
   if (text == "default") {
-    lower = robot.region_lower;
-    upper = robot.region_upper;
+    lower = robot.region.lower;
+    upper = robot.region.upper;
     return;
   }
   if (text == "limits") {
@@ -410,7 +410,7 @@ int run(const CLI::App& app, BuildOptions& o) {
   const RobotModel robot = load_robot(o.robot_path);
   const Environment env = load_environment(o.env_path);
   refuse_output_as_input({"--out", o.out_path}, {{"--robot", o.robot_path},
-                                                 {"URDF", robot.urdf_path},
+                                                 {"URDF", robot.files.urdf},
                                                  {"--env", o.env_path},
                                                  {"--region", o.region}});
   const CollisionModel collision = build_collision_model(robot, env);

@@ -324,8 +324,8 @@ int run(const Options& o) {
   const PlanningSession session(o.bundle_path, !o.no_mmap, o.robot_path, o.env_path);
   refuse_output_as_input({"--out", o.out_path}, {{"--bundle", o.bundle_path},
                                                  {"--queries", o.queries_path},
-                                                 {"robot config", session.robot.config_path},
-                                                 {"URDF", session.robot.urdf_path},
+                                                 {"robot config", session.robot.files.config},
+                                                 {"URDF", session.robot.files.urdf},
                                                  {"environment", session.world().env.path}});
   report_load(o, session);
   Job job{session, QueryDefaults{}, mode, o.trajectory_dir};

@@ -112,14 +112,14 @@ json body_json(const RobotModel& robot, const CollisionBody& c) {
 json info_json(const RobotModel& robot, const CollisionModel& cm) {
   json j;
   j["name"] = robot.name;
-  j["config"] = robot.config_path;
-  j["urdf"] = robot.urdf_path;
+  j["config"] = robot.files.config;
+  j["urdf"] = robot.files.urdf;
   j["dof"] = robot.dof;
   j["gravity"] = vec_json(robot.gravity);
   j["control_rate"] = robot.control_rate;
   j["tip_link"] = robot.links[robot.tip_link()].name;
-  j["sampling_region"] = {{"lower", vec_json(robot.region_lower)},
-                          {"upper", vec_json(robot.region_upper)}};
+  j["sampling_region"] = {{"lower", vec_json(robot.region.lower)},
+                          {"upper", vec_json(robot.region.upper)}};
   for (const Joint& jt : robot.joints) {
     j["joints"].push_back({{"name", jt.name},
                            {"type", joint_type_name(jt)},
@@ -141,11 +141,11 @@ json info_json(const RobotModel& robot, const CollisionModel& cm) {
     j["links"].push_back(
         {{"name", l.name}, {"moved_by", l.body < 0 ? "base" : robot.joints[l.body].name}});
   }
-  for (const CollisionBody& c : robot.collision_bodies) {
+  for (const CollisionBody& c : robot.geometry.bodies) {
     j["collision_bodies"].push_back(body_json(robot, c));
   }
-  j["collision_margin"] = robot.collision_margin;
-  for (const auto& [a, b] : robot.allowed_pairs) {
+  j["collision_margin"] = robot.geometry.margin;
+  for (const auto& [a, b] : robot.geometry.allowed_pairs) {
     j["allowed_pairs"].push_back({robot.links[a].name, robot.links[b].name});
   }
   j["self_pairs_tested"] = cm.self_pairs.size();
@@ -163,8 +163,8 @@ void print_controller_and_region(const RobotModel& robot) {
               robot.controller.friction_feedforward ? ", friction feed-forward" : "");
   for (int i = 0; i < robot.dof && robot.controller.present; ++i)
     std::printf("  %-20s kv %9.4g  ka %9.4g  region [%.4g, %.4g]\n", robot.joints[i].name.c_str(),
-                robot.controller.kv[i], robot.controller.ka[i], robot.region_lower[i],
-                robot.region_upper[i]);
+                robot.controller.kv[i], robot.controller.ka[i], robot.region.lower[i],
+                robot.region.upper[i]);
 }
 
 int cmd_info(const RobotModel& robot, bool as_json) {
@@ -173,8 +173,8 @@ int cmd_info(const RobotModel& robot, bool as_json) {
     std::cout << info_json(robot, cm).dump(2) << "\n";
     return 0;
   }
-  std::printf("robot %s\n  config %s\n  urdf   %s\n", robot.name.c_str(), robot.config_path.c_str(),
-              robot.urdf_path.c_str());
+  std::printf("robot %s\n  config %s\n  urdf   %s\n", robot.name.c_str(),
+              robot.files.config.c_str(), robot.files.urdf.c_str());
   std::printf("%d moving joints, gravity (%g, %g, %g) m/s^2, control rate %g Hz\n\n", robot.dof,
               robot.gravity.x(), robot.gravity.y(), robot.gravity.z(), robot.control_rate);
   std::printf("%-14s %-9s %9s %9s %8s %8s %8s %7s %8s  %s\n", "joint", "type", "lower", "upper",
@@ -199,13 +199,13 @@ int cmd_info(const RobotModel& robot, bool as_json) {
     for (const std::string& n : robot.ignored_links) std::printf(" %s", n.c_str());
     std::printf("\n");
   }
-  std::printf("\ncollision bodies (margin %g m):\n", robot.collision_margin);
-  for (const CollisionBody& c : robot.collision_bodies) {
+  std::printf("\ncollision bodies (margin %g m):\n", robot.geometry.margin);
+  for (const CollisionBody& c : robot.geometry.bodies) {
     std::printf("  %-16s %-14s %s\n", c.name.c_str(), robot.links[c.link].name.c_str(),
                 body_text(c).c_str());
   }
   std::printf("allowed-collision link pairs: %zu; body pairs tested for self-collision: %zu\n",
-              robot.allowed_pairs.size(), cm.self_pairs.size());
+              robot.geometry.allowed_pairs.size(), cm.self_pairs.size());
   print_controller_and_region(robot);
   return 0;
 }
@@ -532,7 +532,7 @@ int main(int argc, char** argv) {
       lazyboe::refuse_output_as_input({"--out", out_path},
                                       {{"--in", in_path},
                                        {"--robot", robot_path},
-                                       {"URDF", robot.urdf_path},
+                                       {"URDF", robot.files.urdf},
                                        {"--env", *check ? env_path : std::string()}});
     }
     if (*info) return cmd_info(robot, info_json);

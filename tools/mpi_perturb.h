@@ -23,7 +23,7 @@ inline std::string perturb_job(const BundleScene& scene, const BundleHeader& h,
                                const PerturbSettings& s, const SimulationOptions& options) {
   std::string out;
   ByteWriter w(out);
-  put_scene_inputs(w, scene.robot.config_path, scene.env.path, h);
+  put_scene_inputs(w, scene.robot.files.config, scene.env.path, h);
   w.put(s);
   w.put(options);
   w.put<int64_t>(h.dof);

@@ -133,7 +133,7 @@ Bundle new_bundle(const RobotModel& robot, const Environment& env, const BuildSe
   BundleHeader& h = b.header;
   h.tool_version = version();
   h.robot_name = robot.name;
-  h.robot_config = robot.config_path;
+  h.robot_config = robot.files.config;
   h.robot_hash = robot_identity(robot);
   h.env_name = env.name;
   h.env_file = env.path;

@@ -11,8 +11,8 @@
 namespace lazyboe {
 
 std::string robot_identity(const RobotModel& robot) {
-  std::vector<std::string> files = {robot.config_path, robot.urdf_path};
-  files.insert(files.end(), robot.resource_files.begin(), robot.resource_files.end());
+  std::vector<std::string> files = {robot.files.config, robot.files.urdf};
+  files.insert(files.end(), robot.files.resources.begin(), robot.files.resources.end());
   return hash_files(files);
 }
 

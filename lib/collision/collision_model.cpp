@@ -274,9 +274,9 @@ CollisionModel build_collision_model(const RobotModel& robot, const Environment&
                                      const CollisionOptions& options) {
   CollisionModel model;
   auto shapes = std::make_shared<CollisionShapes>();
-  model.margin = robot.collision_margin;
+  model.margin = robot.geometry.margin;
   shapes->margin = model.margin;
-  for (const CollisionBody& cb : robot.collision_bodies) {
+  for (const CollisionBody& cb : robot.geometry.bodies) {
     CollisionModel::RobotShape s;
     s.name = cb.name;
     s.link = cb.link;
@@ -323,7 +323,8 @@ CollisionModel build_collision_model(const RobotModel& robot, const Environment&
       const auto& sa = model.robot[a];
       const auto& sb = model.robot[b];
       if (sa.body == sb.body) continue;  // rigidly joined: their distance never changes
-      if (!options.ignore_allowed_pairs && robot.is_allowed_pair(sa.link, sb.link)) continue;
+      if (!options.ignore_allowed_pairs && robot.geometry.is_allowed_pair(sa.link, sb.link))
+        continue;
       model.self_pairs.emplace_back(a, b);
     }
   }

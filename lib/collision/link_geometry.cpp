@@ -138,12 +138,12 @@ MeshRepresentation MeshSettings::of(const std::string& link) const {
 
 void add_link_collision_bodies(RobotModel& model, const urdf::Link& link, int link_index,
                                const MeshSettings& meshes) {
-  const std::vector<std::string> search = package_search_path(model.package_path);
+  const std::vector<std::string> search = package_search_path(model.files.package_path);
   std::vector<Element> elements;
   for (size_t k = 0; k < link.collision_array.size(); ++k) {
     const urdf::Collision& c = *link.collision_array[k];
     const std::string where =
-        model.urdf_path + ": link '" + link.name + "' collision " + std::to_string(k);
+        model.files.urdf + ": link '" + link.name + "' collision " + std::to_string(k);
     if (!c.geometry) fail(where, "missing geometry");
     Element e;
     e.body.name = c.name.empty() ? link.name + "_" + std::to_string(k) : c.name;
@@ -151,10 +151,10 @@ void add_link_collision_bodies(RobotModel& model, const urdf::Link& link, int li
     e.body.in_link = pose_from_urdf(c.origin);
     if (c.geometry->type == urdf::Geometry::MESH) {
       const auto& m = static_cast<const urdf::Mesh&>(*c.geometry);
-      e.body.mesh_file = resolve_urdf_resource(m.filename, model.urdf_path, search, where);
+      e.body.mesh_file = resolve_urdf_resource(m.filename, model.files.urdf, search, where);
       set_mesh_shape(e.body, read_link_mesh(e.body.mesh_file, m, where), meshes.of(link.name),
                      where);
-      model.resource_files.push_back(e.body.mesh_file);
+      model.files.resources.push_back(e.body.mesh_file);
     } else {
       e.body.shape = primitive_shape(*c.geometry, where);
     }
@@ -162,7 +162,7 @@ void add_link_collision_bodies(RobotModel& model, const urdf::Link& link, int li
   }
   merge_capsules(elements);
   for (Element& e : elements)
-    if (!e.used) model.collision_bodies.push_back(std::move(e.body));
+    if (!e.used) model.geometry.bodies.push_back(std::move(e.body));
 }
 
 }  // namespace lazyboe

@@ -23,7 +23,7 @@ struct MeshSettings {
   MeshRepresentation of(const std::string& link) const;
 };
 
-// Appends the collision bodies of `link` (model link `link_index`) to model.collision_bodies
+// Appends the collision bodies of `link` (model link `link_index`) to model.geometry.bodies
 // and the mesh files it read to model.resource_files; mesh URIs are resolved from
 // model.urdf_path and model.package_path (resource_path.h). Throws Error("<urdf>: link 'l'
 // collision k: ...") for a missing, unreadable, empty, flat or non-mesh file, a package that is

@@ -33,7 +33,7 @@ void ik_seed(const RobotModel& robot, const JointVectorRef& start, const EndPose
   const int random = attempt - 1 - static_cast<int>(near.size());
   const bool in_region = random < (kIkAttempts - 1 - static_cast<int>(near.size())) / 2;
   for (int i = 0; i < robot.dof; ++i) {
-    q[i] = in_region ? rng.uniform(robot.region_lower[i], robot.region_upper[i])
+    q[i] = in_region ? rng.uniform(robot.region.lower[i], robot.region.upper[i])
                      : rng.uniform(robot.q_min[i], robot.q_max[i]);
   }
 }

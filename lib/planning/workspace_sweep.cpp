@@ -41,7 +41,7 @@ SweptShape swept_shape(const RobotModel& robot, const CollisionBody& cb) {
       s.radius = farthest_vertex(*cb.shape.mesh);
       break;
   }
-  s.radius += robot.collision_margin;
+  s.radius += robot.geometry.margin;
   return s;
 }
 
@@ -50,7 +50,7 @@ SweptShape swept_shape(const RobotModel& robot, const CollisionBody& cb) {
 std::vector<SweptShape> swept_shapes(const RobotModel& robot, std::vector<int>& links) {
   std::vector<SweptShape> shapes;
   links.clear();
-  for (const CollisionBody& cb : robot.collision_bodies) {
+  for (const CollisionBody& cb : robot.geometry.bodies) {
     if (robot.links[cb.link].body < 0) continue;  // fixed to the base
     SweptShape s = swept_shape(robot, cb);
     const auto at = std::find(links.begin(), links.end(), cb.link);

@@ -150,7 +150,7 @@ void read_collision(RobotModel& model, const JsonField& root,
                     const std::vector<urdf::LinkConstSharedPtr>& link_sources) {
   const JsonField collision = root.at("collision");
   collision.allow_only({"margin", "allowed_pairs", "meshes"});
-  model.collision_margin = collision.at("margin").number_in(kCollisionMargin, " m");
+  model.geometry.margin = collision.at("margin").number_in(kCollisionMargin, " m");
   const MeshSettings meshes = read_mesh_settings(model, collision);
   for (size_t i = 0; i < model.links.size(); ++i) {
     add_link_collision_bodies(model, *link_sources[i], static_cast<int>(i), meshes);
@@ -166,11 +166,12 @@ void read_collision(RobotModel& model, const JsonField& root,
       if (idx[k] < 0) names[k].fail("unknown link '" + n + "'");
     }
     if (idx[0] == idx[1]) pair.fail("a pair needs two different links");
-    model.allowed_pairs.emplace_back(std::min(idx[0], idx[1]), std::max(idx[0], idx[1]));
+    model.geometry.allowed_pairs.emplace_back(std::min(idx[0], idx[1]), std::max(idx[0], idx[1]));
   }
-  std::sort(model.allowed_pairs.begin(), model.allowed_pairs.end());
-  model.allowed_pairs.erase(std::unique(model.allowed_pairs.begin(), model.allowed_pairs.end()),
-                            model.allowed_pairs.end());
+  std::sort(model.geometry.allowed_pairs.begin(), model.geometry.allowed_pairs.end());
+  model.geometry.allowed_pairs.erase(
+      std::unique(model.geometry.allowed_pairs.begin(), model.geometry.allowed_pairs.end()),
+      model.geometry.allowed_pairs.end());
 }
 
 // The per-joint limit vectors, from the joints.
@@ -195,13 +196,13 @@ void fill_limits(RobotModel& model) {
 // The sampling region (default: the joint limits).
 void read_sampling_region(RobotModel& model, const JsonField& root) {
   const int n = model.dof;
-  model.region_lower = model.q_min;
-  model.region_upper = model.q_max;
+  model.region.lower = model.q_min;
+  model.region.upper = model.q_max;
   if (!root.has("sampling_region")) return;
   const JsonField region = root.at("sampling_region");
   region.allow_only({"description", "lower", "upper"});
-  for (auto [key, bound] : {std::pair<const char*, JointVector*>{"lower", &model.region_lower},
-                            std::pair<const char*, JointVector*>{"upper", &model.region_upper}}) {
+  for (auto [key, bound] : {std::pair<const char*, JointVector*>{"lower", &model.region.lower},
+                            std::pair<const char*, JointVector*>{"upper", &model.region.upper}}) {
     const std::vector<JsonField> v = region.at(key).items();
     if (static_cast<int>(v.size()) != n) {
       region.at(key).fail("expected " + std::to_string(n) + " values, one per moving joint");
@@ -209,10 +210,10 @@ void read_sampling_region(RobotModel& model, const JsonField& root) {
     for (int i = 0; i < n; ++i) (*bound)[i] = v[i].number_in(kRegionBound, " rad or m");
   }
   for (int i = 0; i < n; ++i) {
-    if (!(model.region_lower[i] < model.region_upper[i])) {
+    if (!(model.region.lower[i] < model.region.upper[i])) {
       region.fail("joint " + std::to_string(i + 1) + ": lower must be below upper");
     }
-    if (model.region_lower[i] < model.q_min[i] || model.region_upper[i] > model.q_max[i]) {
+    if (model.region.lower[i] < model.q_min[i] || model.region.upper[i] > model.q_max[i]) {
       region.fail("joint " + std::to_string(i + 1) + ": outside the joint limits");
     }
   }
@@ -257,13 +258,13 @@ RobotModel robot_from_json(const nlohmann::json& config, const std::string& conf
   }
 
   RobotModel model;
-  model.config_path = config_path;
+  model.files.config = config_path;
   model.name = root.at("name").string();
   const std::string urdf_rel = root.at("urdf").string();
-  model.urdf_path = (fs::path(config_path).parent_path() / urdf_rel).lexically_normal().string();
+  model.files.urdf = (fs::path(config_path).parent_path() / urdf_rel).lexically_normal().string();
   if (root.has("package_path")) {
     for (const JsonField& dir : root.at("package_path").items())
-      model.package_path.push_back(
+      model.files.package_path.push_back(
           (fs::path(config_path).parent_path() / dir.string()).lexically_normal().string());
   }
   if (root.has("gravity")) model.gravity = root.at("gravity").vec3_in(kGravity, " m/s^2");
@@ -273,8 +274,8 @@ RobotModel robot_from_json(const nlohmann::json& config, const std::string& conf
     model.control_rate = static_cast<double>(rate);
   }
 
-  const urdf::ModelInterfaceSharedPtr urdf_model = parse_urdf_file(model.urdf_path);
-  const std::string& upath = model.urdf_path;
+  const urdf::ModelInterfaceSharedPtr urdf_model = parse_urdf_file(model.files.urdf);
+  const std::string& upath = model.files.urdf;
   std::string base_name;
   const std::vector<urdf::LinkConstSharedPtr> chain =
       find_chain(root, *urdf_model, upath, config_path, base_name);

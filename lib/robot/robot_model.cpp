@@ -76,7 +76,7 @@ int RobotModel::link_index(const std::string& link_name) const {
   return -1;
 }
 
-bool RobotModel::is_allowed_pair(int link_a, int link_b) const {
+bool RobotGeometry::is_allowed_pair(int link_a, int link_b) const {
   const std::pair<int, int> key(std::min(link_a, link_b), std::max(link_a, link_b));
   return std::binary_search(allowed_pairs.begin(), allowed_pairs.end(), key);
 }

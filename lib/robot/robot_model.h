@@ -8,6 +8,7 @@
 #include <utility>
 #include <vector>
 
+#include "lazyboe/robot/robot_geometry.h"
 #include "lazyboe/robot/types.h"
 
 namespace lazyboe {
@@ -65,45 +66,6 @@ struct Link {
   Pose in_body;   // link frame in the body frame
 };
 
-struct TriangleMesh;  // lazyboe/collision/mesh.h
-
-enum class ShapeType { Sphere, Box, Cylinder, Capsule, Mesh };
-struct Shape {
-  ShapeType type = ShapeType::Sphere;
-  double radius = 0;                               // sphere, cylinder, capsule
-  double length = 0;                               // cylinder, capsule: along local z
-  Eigen::Vector3d size = Eigen::Vector3d::Zero();  // box: full extents
-  std::shared_ptr<const TriangleMesh> mesh;        // mesh: triangles about the shape's frame
-  bool convex = false;  // mesh: a convex hull, checked as one convex shape (GJK), not a BVH
-};
-const char* shape_type_name(ShapeType type);
-
-// How a link whose URDF collision geometry is a mesh is checked: a capsule fitted around the
-// mesh (the fast primitive checks; conservative by its over-approximation), the mesh itself
-// (FCL's bounding volume hierarchy: exact, slower), or its convex hull (Qhull; one convex shape
-// for GJK: exact for a convex part, never less conservative than the mesh, and fast).
-enum class MeshRepresentation { Fitted, Exact, Convex };
-const char* mesh_representation_name(MeshRepresentation representation);
-// The inverse; throws Error("<where>: unknown mesh representation '<name>' (expected fitted,
-// exact or convex)").
-MeshRepresentation parse_mesh_representation(const std::string& name, const std::string& where);
-
-struct CollisionBody {
-  std::string name;
-  int link = 0;  // index into RobotModel::links
-  Shape shape;
-  Pose in_link;  // shape frame in the link frame
-  // For URDF mesh geometry: the file, how it is represented, and for a fitted shape the
-  // largest distance from its surface to the mesh (m).
-  std::string mesh_file;
-  MeshRepresentation representation = MeshRepresentation::Fitted;
-  double over_approximation = 0;
-  // A fitted or convex mesh link: the mesh as read (scaled) and its frame in the link, which the
-  // viewer draws, whatever stands for it in the checks.
-  std::shared_ptr<const TriangleMesh> source_mesh;
-  Pose source_in_link;
-};
-
 // Joint-level controller used to simulate the robot following joint-velocity commands: a
 // velocity-tracking law with model feed-forward,
 //   tau = g(q) + [tau_f(v_cmd)] + ka a_cmd + kv (v_cmd - dq).
@@ -116,12 +78,27 @@ struct ControllerGains {
   bool friction_feedforward = true;
 };
 
+// The files a robot was read from: together its identity (a bundle's robot_hash).
+struct RobotFiles {
+  std::string config;                     // the robot config
+  std::string urdf;                       // the URDF it names
+  std::vector<std::string> resources;     // files the URDF names (meshes)
+  std::vector<std::string> package_path;  // config "package_path", resolved: package:// folders
+};
+
+// The default box of start states for the edge bundle (config "sampling_region"; the joint
+// limits when the config has none): what lazyboe-build samples and the sampling planners
+// draw from unless told otherwise.
+struct SamplingRegion {
+  JointVector lower, upper;
+};
+
+// The model: the chain's kinematics, dynamics and limits, with what the robot config adds for
+// the layers above it, each part in its own type: the collision geometry (collision layer), the
+// controller gains (simulator), the sampling region (bundle build), and the files.
 struct RobotModel {
   std::string name;
-  std::string config_path;
-  std::string urdf_path;
-  std::vector<std::string> resource_files;  // files the URDF names (meshes): part of its identity
-  std::vector<std::string> package_path;    // config "package_path", resolved: package:// folders
+  RobotFiles files;
   int dof = 0;
   Eigen::Vector3d gravity{0, 0, -9.81};
   double control_rate = 1000;  // Hz
@@ -130,15 +107,11 @@ struct RobotModel {
   std::vector<BodyInertia> bodies;         // size dof
   std::vector<Link> links;                 // every link of the chain, base first
   std::vector<std::string> ignored_links;  // side branches behind moving joints
-  std::vector<CollisionBody> collision_bodies;
-  double collision_margin = 0;
-  std::vector<std::pair<int, int>> allowed_pairs;  // link indices, first < second, sorted
 
-  ControllerGains controller;
+  RobotGeometry geometry;  // collision bodies, margin, allowed pairs (robot_geometry.h)
 
-  // Default box of start states for the edge bundle (config "sampling_region"; the joint
-  // limits when the config has none).
-  JointVector region_lower, region_upper;
+  ControllerGains controller;  // the simulator's joint controller
+  SamplingRegion region;
 
   // Limits gathered as vectors for the validity checks.
   JointVector q_min, q_max, dq_max, ddq_max, dddq_max, tau_max, dtau_max;
@@ -147,7 +120,6 @@ struct RobotModel {
   // "unknown link 'x'" with the closest name ("did you mean") or else the links there are.
   std::string unknown_link(const std::string& link_name) const;
   int tip_link() const { return static_cast<int>(links.size()) - 1; }
-  bool is_allowed_pair(int link_a, int link_b) const;
 };
 
 }  // namespace lazyboe

@@ -118,7 +118,7 @@ std::vector<std::string> setup_notes(const RobotModel& robot, const SrdfDescript
                 kAccelerationPerVelocity, kJerkPerAcceleration, kTorqueRatePerEffort);
   notes.push_back(line);
   notes.push_back("friction: none assumed (identify it and set joints[].friction)");
-  for (const CollisionBody& b : robot.collision_bodies) {
+  for (const CollisionBody& b : robot.geometry.bodies) {
     if (b.mesh_file.empty() || b.representation != MeshRepresentation::Fitted) continue;
     std::snprintf(line, sizeof line, "link %s: mesh fitted with a %s, over-approximation %.1f mm",
                   robot.links[b.link].name.c_str(), shape_type_name(b.shape.type),

@@ -105,7 +105,8 @@ Simulator::Simulator(const RobotModel& robot_model, const CollisionModel& collis
       dt(1.0 / robot_model.control_rate),
       lever_arm(collision_lever_arms(robot_model, collision_model)) {
   if (!robot.controller.present) {
-    fail(robot.config_path, "controller: missing (the simulator needs the joint controller gains)");
+    fail(robot.files.config,
+         "controller: missing (the simulator needs the joint controller gains)");
   }
   if (options.substeps < 1) fail("substeps", "must be >= 1");
 }

@@ -71,7 +71,7 @@ json robot_view_json(const RobotModel& robot) {
   }
   for (const Link& l : robot.links)
     links.push_back({{"name", l.name}, {"body", l.body}, {"in_body", pose_json(l.in_body)}});
-  for (const CollisionBody& b : robot.collision_bodies) {
+  for (const CollisionBody& b : robot.geometry.bodies) {
     json s = shape_json(b.name, b.shape, b.in_link);
     s["link"] = b.link;
     if (b.source_mesh) {  // drawn as its mesh; the shape checked stays in the data
@@ -80,7 +80,7 @@ json robot_view_json(const RobotModel& robot) {
     }
     shapes.push_back(s);
   }
-  return {{"name", robot.name},     {"config", robot.config_path},
+  return {{"name", robot.name},     {"config", robot.files.config},
           {"dof", robot.dof},       {"joints", joints},
           {"links", links},         {"shapes", shapes},
           {"tip", robot.tip_link()}};

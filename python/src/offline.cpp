@@ -84,8 +84,8 @@ void check_settings(const BuildSettings& s) {
 void apply_region(const py::object& region, const RobotModel& robot, BuildSettings& s) {
   if (region.is_none() ||
       (py::isinstance<py::str>(region) && region.cast<std::string>() == "default")) {
-    s.region_lower = robot.region_lower;
-    s.region_upper = robot.region_upper;
+    s.region_lower = robot.region.lower;
+    s.region_upper = robot.region.upper;
   } else if (py::isinstance<py::str>(region) && region.cast<std::string>() == "limits") {
     s.region_lower = robot.q_min;
     s.region_upper = robot.q_max;

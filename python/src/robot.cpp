@@ -231,7 +231,7 @@ void bind_robot_properties(py::class_<PyRobot>& c) {
       .def_property_readonly(
           "name", [](const PyRobot& r) { return r.model->name; }, "The robot config's name.")
       .def_property_readonly(
-          "config_path", [](const PyRobot& r) { return r.model->config_path; },
+          "config_path", [](const PyRobot& r) { return r.model->files.config; },
           "The robot config file.")
       .def_property_readonly(
           "dof", [](const PyRobot& r) { return r.model->dof; }, "Joints of the chain.")
@@ -266,10 +266,10 @@ void bind_robot_properties(py::class_<PyRobot>& c) {
           "torque_rate_limits", [](const PyRobot& r) { return to_array(r.model->dtau_max); },
           "Joint torque rate limits.")
       .def_property_readonly(
-          "region_lower", [](const PyRobot& r) { return to_array(r.model->region_lower); },
+          "region_lower", [](const PyRobot& r) { return to_array(r.model->region.lower); },
           "Default sampling box of bundle start states, lower corner.")
       .def_property_readonly(
-          "region_upper", [](const PyRobot& r) { return to_array(r.model->region_upper); },
+          "region_upper", [](const PyRobot& r) { return to_array(r.model->region.upper); },
           "Default sampling box of bundle start states, upper corner.");
 }
 

@@ -76,7 +76,7 @@ void use_robot(const RobotModel& robot, const Environment& env) {
   const CollisionModel collision = build_collision_model(robot, env);
   const Simulator sim(robot, collision, SimulationOptions{});
   SimulatorWorkspace ws(sim);
-  const Eigen::VectorXd q = 0.5 * (robot.region_lower + robot.region_upper);
+  const Eigen::VectorXd q = 0.5 * (robot.region.lower + robot.region.upper);
   check_state(sim, ws, q);
   gravity_torques(robot, ws.robot, q);
   mass_matrix(robot, ws.robot, q);
