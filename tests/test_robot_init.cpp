@@ -4,10 +4,15 @@
 // every joint; an SRDF gives the chain and its disabled pairs.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "lazyboe/common/error.h"
+#include "lazyboe/robot/dynamics.h"
+#include "lazyboe/robot/robot_config.h"
+#include "lazyboe/sim/random.h"
 #include "lazyboe/sim/robot_setup.h"
 #include "test_util.h"
 
@@ -124,6 +129,47 @@ TEST(RobotInit, AnSrdfGivesTheChainAndItsDisabledPairs) {
     EXPECT_NE(std::string(e.what()).find("group 'hand' has no <chain>"), std::string::npos)
         << e.what();
   }
+}
+
+// The gains' feed-forward and the step check use a configuration of typical inertia: for the
+// UR5 its mass-matrix diagonal is nearer the per-joint medians over the joint limits (drawn here
+// with another seed; distance in log) than 90% of the drawn configurations are, where the
+// middle of the limits (the arm stretched out) puts the shoulder's M_ii above its 90th
+// percentile; and the shipped ka is M_ii there (to init's 3 significant digits).
+TEST(RobotInit, GainsAndStepsUseAConfigurationOfTypicalInertia) {
+  const RobotModel robot = load_robot(test::source_path("data/robots/ur5.json"));
+  RobotModel whole = robot;  // init samples the joint limits
+  whole.region = {robot.q_min, robot.q_max};
+  const JointVector typical = typical_inertia_configuration(whole, 1, 1000);
+  RobotData data(robot);
+  const int n = robot.dof;
+  std::vector<JointVector> logs;
+  Random rng(77, 0);
+  JointVector q(n);
+  for (int s = 0; s < 2000; ++s) {
+    for (int i = 0; i < n; ++i) q[i] = rng.uniform(robot.q_min[i], robot.q_max[i]);
+    logs.push_back(mass_matrix(robot, data, q).diagonal().array().log().matrix());
+  }
+  JointVector median(n);
+  std::vector<double> column(logs.size());
+  for (int i = 0; i < n; ++i) {
+    for (size_t s = 0; s < logs.size(); ++s) column[s] = logs[s][i];
+    std::sort(column.begin(), column.end());
+    median[i] = column[column.size() / 2];
+    if (i == 0) {
+      const JointVector middle = (robot.q_min + robot.q_max) / 2;
+      EXPECT_GT(std::log(mass_matrix(robot, data, middle)(0, 0)), column[column.size() * 9 / 10])
+          << "the middle of the limits is not typical";
+    }
+  }
+  const JointVector at_typical = mass_matrix(robot, data, typical).diagonal();
+  const double distance = (at_typical.array().log().matrix() - median).norm();
+  size_t nearer = 0;
+  for (const JointVector& l : logs) nearer += (l - median).norm() < distance;
+  EXPECT_LT(nearer, logs.size() / 10) << "distance " << distance;
+  for (int i = 0; i < n; ++i)
+    EXPECT_NEAR(robot.controller.ka[i], at_typical[i], 0.005 * at_typical[i])
+        << robot.joints[i].name;
 }
 
 }  // namespace

@@ -70,9 +70,9 @@ json draft_config(const RobotSetupOptions& o, const std::string& base, const std
   return config;
 }
 
-// ka: the joint inertia M_ii at the middle of the limits; kv: the velocity loop's time constant
-// M_ii / kv at most `time_constant` at the largest sampled M_ii, and kv T / M_ii at most 0.3 at
-// the smallest (the discrete loop's stability at the control period T).
+// ka: the joint inertia M_ii at the configuration of typical inertia; kv: the velocity loop's time
+// constant M_ii / kv at most `time_constant` at the largest sampled M_ii, and kv T / M_ii at most
+// 0.3 at the smallest (the discrete loop's stability at the control period T).
 json controller_gains(const RobotModel& robot, const RobotSetupOptions& o) {
   RobotData data(robot);
   const int n = robot.dof;
@@ -85,19 +85,20 @@ json controller_gains(const RobotModel& robot, const RobotSetupOptions& o) {
     lo = lo.cwiseMin(diagonal);
     hi = hi.cwiseMax(diagonal);
   }
-  const JointVector middle = (robot.q_min + robot.q_max) / 2;
-  const JointVector ka = mass_matrix(robot, data, middle).diagonal();
+  const JointVector typical = typical_inertia_configuration(robot, o.seed, o.inertia_samples);
+  const JointVector ka = mass_matrix(robot, data, typical).diagonal();
   json kv = json::array(), ka_json = json::array();
   for (int i = 0; i < n; ++i) {
     kv.push_back(rounded(std::min(hi[i] / o.time_constant, 0.3 * lo[i] * robot.control_rate), 3));
     ka_json.push_back(rounded(ka[i], 3));
   }
   char text[400];
-  std::snprintf(text, sizeof text,
-                "Written by lazyboe-robot init: ka is M_ii at the middle of the joint limits; kv "
-                "= min(max M_ii / %g s, 0.3 min M_ii x control rate) over %ld configurations "
-                "sampled in the joint limits (seed %llu).",
-                o.time_constant, o.inertia_samples, static_cast<unsigned long long>(o.seed));
+  std::snprintf(
+      text, sizeof text,
+      "Written by lazyboe-robot init: ka is M_ii at the configuration of typical inertia; kv "
+      "= min(max M_ii / %g s, 0.3 min M_ii x control rate) over %ld configurations "
+      "sampled in the joint limits (seed %llu).",
+      o.time_constant, o.inertia_samples, static_cast<unsigned long long>(o.seed));
   return {{"type", "velocity_tracking"},
           {"description", text},
           {"kv", kv},
@@ -133,13 +134,37 @@ std::vector<std::string> setup_notes(const RobotModel& robot, const SrdfDescript
 
 }  // namespace
 
-std::vector<StepCheck> check_velocity_steps(const RobotModel& robot) {
+JointVector typical_inertia_configuration(const RobotModel& robot, uint64_t seed, long samples) {
+  RobotData data(robot);
+  const int n = robot.dof;
+  Random rng(seed, 1);
+  std::vector<JointVector> qs, diagonals;
+  JointVector q(n);
+  for (long s = 0; s < std::max(1L, samples); ++s) {
+    for (int i = 0; i < n; ++i) q[i] = rng.uniform(robot.region.lower[i], robot.region.upper[i]);
+    qs.push_back(q);
+    diagonals.push_back(mass_matrix(robot, data, q).diagonal().array().log().matrix());
+  }
+  JointVector median(n);
+  std::vector<double> column(qs.size());
+  for (int i = 0; i < n; ++i) {
+    for (size_t s = 0; s < qs.size(); ++s) column[s] = diagonals[s][i];
+    std::nth_element(column.begin(), column.begin() + column.size() / 2, column.end());
+    median[i] = column[column.size() / 2];
+  }
+  size_t best = 0;
+  for (size_t s = 1; s < qs.size(); ++s)
+    if ((diagonals[s] - median).squaredNorm() < (diagonals[best] - median).squaredNorm()) best = s;
+  return qs[best];
+}
+
+std::vector<StepCheck> check_velocity_steps(const RobotModel& robot, uint64_t seed, long samples) {
   CollisionModel collision = build_collision_model(robot, Environment{});
   collision.self_pairs.clear();  // the gains are checked, not the geometry
   const Simulator sim(robot, collision, SimulationOptions{});
   SimulatorWorkspace ws(sim);
   const int n = robot.dof;
-  const JointVector middle = (robot.q_min + robot.q_max) / 2;
+  const JointVector start = typical_inertia_configuration(robot, seed, samples);
   std::vector<StepCheck> steps;
   std::vector<double> knots(5 * n), ticks;
   for (int i = 0; i < n; ++i) {
@@ -152,7 +177,7 @@ std::vector<StepCheck> check_velocity_steps(const RobotModel& robot) {
     ticks.clear();
     StepCheck step;
     step.joint = robot.joints[i].name;
-    step.status = simulate(sim, ws, middle, profile, samples).status;
+    step.status = simulate(sim, ws, start, profile, samples).status;
     for (size_t row = 0; row + 4 * n <= ticks.size(); row += 4 * n) {
       const double error = std::abs(ticks[row + n + i] - ticks[row + 3 * n + i]) / v;
       step.tracking_error = std::max(step.tracking_error, error);
@@ -189,7 +214,7 @@ RobotSetup make_robot_config(const RobotSetupOptions& o) {
   }
   for (const auto& [a, b] : pairs) setup.config["collision"]["allowed_pairs"].push_back({a, b});
   const RobotModel robot = robot_from_json(nlohmann::json::parse(setup.config.dump()), o.out_path);
-  setup.steps = check_velocity_steps(robot);
+  setup.steps = check_velocity_steps(robot, o.seed, o.inertia_samples);
   setup.notes = setup_notes(robot, srdf);
   char line[300];
   std::snprintf(line, sizeof line,

@@ -38,8 +38,8 @@ struct RobotSetupOptions {
   std::string out_path;  // where the config goes: its relative paths start from its folder
 };
 
-// One joint's velocity step from the middle of its range: the rollout's outcome and the largest
-// velocity tracking error as a fraction of the step.
+// One joint's velocity step from a configuration of typical inertia: the rollout's outcome and the
+// largest velocity tracking error as a fraction of the step.
 struct StepCheck {
   std::string joint;
   RolloutStatus status = RolloutStatus::Valid;
@@ -58,9 +58,17 @@ struct RobotSetup {
 // Throws Error naming the file and element for a URDF or SRDF the config cannot be made from.
 RobotSetup make_robot_config(const RobotSetupOptions& options);
 
+// The configuration of typical inertia: of `samples` configurations drawn in the robot's
+// sampling region (seeded), the one whose mass-matrix diagonal is nearest the per-joint median
+// (in log, so that every joint counts alike). Where the bundle's edges typically start; the
+// middle of the limits can be a singular pose (an arm straight up) whose small inertias make
+// the coupled loops far livelier than anywhere a rollout starts.
+JointVector typical_inertia_configuration(const RobotModel& robot, uint64_t seed, long samples);
+
 // Simulates, for each joint in turn, a velocity step of 0.3 x its limit (0.25 s minimum-jerk
-// ramps, 0.5 s held) from the middle of the joint limits with the other joints commanded still,
-// checking limits but not collisions.
-std::vector<StepCheck> check_velocity_steps(const RobotModel& robot);
+// ramps, 0.5 s held) from the configuration of typical inertia with the other joints commanded
+// still, checking limits but not collisions.
+std::vector<StepCheck> check_velocity_steps(const RobotModel& robot, uint64_t seed = 1,
+                                            long samples = 1000);
 
 }  // namespace lazyboe
