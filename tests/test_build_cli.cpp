@@ -792,18 +792,24 @@ TEST(BuildCli, ProgressNamesTheTopRejection) {
   EXPECT_TRUE(contains(r.err, ", top rejection ")) << r.err;
 }
 
+// The Panda with every torque-rate limit set to `rate` N m/s, as dir/slow.json.
+std::string panda_with_torque_rate(const std::string& dir, const std::string& rate) {
+  std::ifstream in(source_path("data/robots/panda.json"));
+  const std::string config((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string slow = std::regex_replace(config, std::regex(R"("max_torque_rate": [0-9.]+)"),
+                                              "\"max_torque_rate\": " + rate);
+  EXPECT_NE(slow, config);
+  write_bytes(dir + "/slow.json", slow);
+  std::filesystem::copy_file(source_path("data/robots/panda.urdf"), dir + "/panda.urdf");
+  return dir + "/slow.json";
+}
+
 // A robot whose every motion is rejected (here torque-rate limits of 1 N m/s) stops after the
 // first 2000 attempts with the leading reasons and what to change, not after hours; the
 // partial bundle stays valid.
 TEST(BuildCli, AHopelessBuildStopsEarlyWithTheReason) {
   const std::string dir = fresh_dir("hopeless");
-  std::ifstream in(source_path("data/robots/panda.json"));
-  const std::string config((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  const std::string slow = std::regex_replace(config, std::regex(R"("max_torque_rate": [0-9.]+)"),
-                                              R"("max_torque_rate": 1)");
-  ASSERT_NE(slow, config);
-  write_bytes(dir + "/slow.json", slow);
-  std::filesystem::copy_file(source_path("data/robots/panda.urdf"), dir + "/panda.urdf");
+  panda_with_torque_rate(dir, "1");
   const std::string out = dir + "/b.h5";
   const CommandResult r =
       build_tool({"--robot", dir + "/slow.json", "--out", out, "--edges", "100", "--quiet"});
@@ -814,6 +820,30 @@ TEST(BuildCli, AHopelessBuildStopsEarlyWithTheReason) {
   const Bundle b = read_bundle(out);
   EXPECT_FALSE(b.header.complete);
   EXPECT_EQ(b.header.attempts, 2000u);
+}
+
+// A build that is slow rather than hopeless (12 N m/s: about 0.5% of the attempts valid on
+// this seed) stops at the check too, and `--keep-going` builds it to the end: complete, every
+// edge there, past the 2000 attempts where the check would have stopped it.
+TEST(BuildCli, KeepGoingBuildsPastTheEarlyStop) {
+  const std::string dir = fresh_dir("keep-going");
+  const std::string robot = panda_with_torque_rate(dir, "12");
+  const std::string out = dir + "/b.h5";
+  const std::vector<std::string> args = {
+      "--robot", robot, "--env", env_file("empty.json"), "--out", out, "--edges", "15", "--quiet"};
+  const CommandResult stopped = build_tool(args);
+  EXPECT_EQ(stopped.exit_code, 1) << describe(stopped);
+  EXPECT_TRUE(contains(stopped.err, "stopped after the first 2000 attempts")) << stopped.err;
+  std::vector<std::string> keep_going = args;
+  keep_going.push_back("--keep-going");
+  keep_going.push_back("--force");
+  const CommandResult r = build_tool(keep_going);
+  ASSERT_EQ(r.exit_code, 0) << describe(r);
+  const Bundle b = read_bundle(out);
+  EXPECT_TRUE(b.header.complete);
+  EXPECT_EQ(b.size(), 15u);
+  EXPECT_GT(b.header.attempts, 2000u);
+  EXPECT_LT(b.header.valid * 50, b.header.attempts);  // under 2% valid: the check's case
 }
 
 TEST(BuildCli, QuietPrintsNothing) {
