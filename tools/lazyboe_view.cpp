@@ -64,8 +64,9 @@ int run(const Options& o) {
              : BundleScene{
                    load_robot(o.robot_path.empty() ? default_robot_path() : o.robot_path),
                    load_environment(o.env_path.empty() ? default_environment_path() : o.env_path)};
+  std::vector<std::string> warnings;
   nlohmann::json data = {{"title", o.title.empty() ? "LazyBoE viewer" : o.title},
-                         {"robot", robot_view_json(scene.robot)},
+                         {"robot", robot_view_json(scene.robot, warnings)},
                          {"environment", environment_view_json(scene.env)},
                          {"results", nullptr},
                          {"bundle", nullptr},
@@ -78,15 +79,19 @@ int run(const Options& o) {
   }
   if (bundle) data["bundle"] = bundle_sample_json(*bundle, scene.robot, {o.bundle_points, o.seed});
 
+  for (const std::string& w : warnings)
+    std::fprintf(stderr, "lazyboe-view: warning: %s\n", w.c_str());
   const std::string page = viewer_page(data, scripts);
   AtomicFile out(o.out_path);
   out.stream() << page;
   out.commit();
   const nlohmann::json& results = data["results"];
   std::printf(
-      "%s: %.2f MB; robot %s, %zu obstacles, %zu trajectories, %zu failed queries, %zu "
+      "%s: %.2f MB; robot %s (%zu visuals), %zu obstacles, %zu trajectories, %zu failed queries, "
+      "%zu "
       "bundle points\n",
-      o.out_path.c_str(), page.size() / 1e6, scene.robot.name.c_str(), scene.env.obstacles.size(),
+      o.out_path.c_str(), page.size() / 1e6, scene.robot.name.c_str(),
+      data["robot"]["visuals"].size(), scene.env.obstacles.size(),
       results.is_null() ? 0 : results["trajectories"].size(),
       results.is_null() ? 0 : results["failures"].size(),
       bundle ? data["bundle"]["density"].size() : 0);

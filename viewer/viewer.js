@@ -248,6 +248,9 @@
   const robot = data.robot;
   const robotLayer = new THREE.Group();  // the robot and its ghosts
   scene.add(robotLayer);
+  const visuals = robot.visuals || [];
+  const visualLinks = new Set(visuals.map((v) => v.link));
+  const drawnShapes = visuals.concat(robot.shapes.filter((s) => !visualLinks.has(s.link)));
   function makeRobot(colour, opacity, layer) {
     // A ghost's surfaces are pushed back in depth, so where it coincides with the robot (at the
     // start, at the goal) the robot is drawn, not a flicker of both.
@@ -256,9 +259,10 @@
                                                     depthWrite: !ghost, polygonOffset: ghost,
                                                     polygonOffsetFactor: 2, polygonOffsetUnits: 2});
     const group = new THREE.Group();
-    // A link whose URDF geometry is a mesh is drawn as that mesh (`display`), whatever stands
-    // for it in the collision checks (a fitted capsule, a convex hull); other shapes as they are.
-    const parts = robot.shapes.map((s) => {
+    // A link with URDF <visual> elements is drawn from them; another link from its collision
+    // geometry: a mesh as that mesh (`display`), whatever stands for it in the checks (a
+    // fitted capsule, a convex hull), other shapes as they are.
+    const parts = drawnShapes.map((s) => {
       const shown = s.display ? Object.assign({type: 'mesh', name: s.name}, s.display) : s;
       const o = shapeObject(shown, material);
       o.layers.set(layer);
@@ -274,7 +278,7 @@
         if (layer !== MOVING_LAYER) stillLayers.changed();
         lastQ = q;
         const poses = linkPoses(robot, q);
-        robot.shapes.forEach((s, i) => setMatrix(parts[i].object, compose(poses[s.link], parts[i].pose)));
+        drawnShapes.forEach((s, i) => setMatrix(parts[i].object, compose(poses[s.link], parts[i].pose)));
         if (payload) setMatrix(payload.box, compose(poses[payload.link], payload.at));
       },
       // The query's payload as a box at its centre of mass on its link (default the tip), or
@@ -667,6 +671,7 @@
   stillLayers.render();
   body.setAttribute('data-robot-shapes', String(robot.shapes.length));
   body.setAttribute('data-robot-meshes', String(robot.shapes.filter((s) => s.display).length));
+  body.setAttribute('data-robot-visuals', String((robot.visuals || []).length));
   body.setAttribute('data-obstacles', String(data.environment.obstacles.length));
   body.setAttribute('data-obstacle-types', data.environment.obstacles.map((o) => o.type).join(' '));
   body.setAttribute('data-trajectories', String(trajectories.length));

@@ -22,7 +22,9 @@ struct Element {
   bool used = false;  // merged into a capsule
 };
 
-Shape primitive_shape(const urdf::Geometry& geometry, const std::string& where) {
+}  // namespace
+
+Shape urdf_primitive_shape(const urdf::Geometry& geometry, const std::string& where) {
   Shape shape;
   switch (geometry.type) {
     case urdf::Geometry::SPHERE:
@@ -50,6 +52,8 @@ Shape primitive_shape(const urdf::Geometry& geometry, const std::string& where) 
   }
   return shape;
 }
+
+namespace {
 
 // The mesh of a <mesh> element, scaled, with the reader's errors prefixed by `where`.
 TriangleMesh read_link_mesh(const std::string& file, const urdf::Mesh& m,
@@ -156,7 +160,7 @@ void add_link_collision_bodies(RobotModel& model, const urdf::Link& link, int li
                      where);
       model.files.resources.push_back(e.body.mesh_file);
     } else {
-      e.body.shape = primitive_shape(*c.geometry, where);
+      e.body.shape = urdf_primitive_shape(*c.geometry, where);
     }
     elements.push_back(std::move(e));
   }

@@ -12,7 +12,8 @@
 
 namespace urdf {
 class Link;
-}
+class Geometry;
+}  // namespace urdf
 
 namespace lazyboe {
 
@@ -30,5 +31,9 @@ struct MeshSettings {
 // not on the path, and a primitive without size.
 void add_link_collision_bodies(RobotModel& model, const urdf::Link& link, int link_index,
                                const MeshSettings& meshes);
+
+// The shape of a URDF sphere, box or cylinder element (also a <visual>'s); throws
+// Error(`where`: ...) for a size that is not > 0 or another geometry type.
+Shape urdf_primitive_shape(const urdf::Geometry& geometry, const std::string& where);
 
 }  // namespace lazyboe

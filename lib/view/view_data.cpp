@@ -16,6 +16,7 @@
 #include "lazyboe/planning/neighbour_index.h"
 #include "lazyboe/robot/kinematics.h"
 #include "lazyboe/sim/random.h"
+#include "lazyboe/view/robot_visuals.h"
 
 namespace lazyboe {
 
@@ -61,7 +62,7 @@ json shape_json(const std::string& name, const Shape& s, const Pose& pose) {
 
 }  // namespace
 
-json robot_view_json(const RobotModel& robot) {
+json robot_view_json(const RobotModel& robot, std::vector<std::string>& warnings) {
   json joints = json::array(), links = json::array(), shapes = json::array();
   for (const Joint& j : robot.joints) {
     joints.push_back({{"name", j.name},
@@ -80,10 +81,16 @@ json robot_view_json(const RobotModel& robot) {
     }
     shapes.push_back(s);
   }
-  return {{"name", robot.name},     {"config", robot.files.config},
-          {"dof", robot.dof},       {"joints", joints},
-          {"links", links},         {"shapes", shapes},
-          {"tip", robot.tip_link()}};
+  json visuals = json::array();
+  for (const RobotVisual& v : load_robot_visuals(robot, warnings)) {
+    json s = shape_json(v.name, v.shape, v.in_link);
+    s["link"] = v.link;
+    visuals.push_back(s);
+  }
+  return {{"name", robot.name}, {"config", robot.files.config},
+          {"visuals", visuals}, {"dof", robot.dof},
+          {"joints", joints},   {"links", links},
+          {"shapes", shapes},   {"tip", robot.tip_link()}};
 }
 
 namespace {

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "lazyboe/bundle/bundle_view.h"
 #include "lazyboe/collision/environment.h"
@@ -15,8 +16,10 @@
 namespace lazyboe {
 
 // {"name", "dof", "joints": [{name, type, origin: {R (row-major), p}, axis}], "links": [{name,
-// body, in_body}], "shapes": [{name, link, type, radius, length, size, pose}], "tip"}.
-nlohmann::json robot_view_json(const RobotModel& robot);
+// body, in_body}], "shapes": [{name, link, type, radius, length, size, pose}], "visuals": [the
+// same, from the URDF's <visual> elements (robot_visuals.h)], "tip"}. `warnings` gets a line per
+// link whose visuals could not be read (drawn from its collision geometry).
+nlohmann::json robot_view_json(const RobotModel& robot, std::vector<std::string>& warnings);
 
 // {"name", "obstacles": [{name, type, radius, length, size, pose}]}.
 nlohmann::json environment_view_json(const Environment& env);

@@ -52,6 +52,32 @@ def failed_result(rid, line, failure):
             "time_to_first_solution": None, "n_solutions": 0, "best_cost": None}
 
 
+def ur5_with_visuals(out_dir):
+    """The UR5 with a <visual> beside every <collision> (the same geometry), the base's naming a
+    mesh file that is not there: its config, and how many visuals can be read."""
+    import re
+    folder = os.path.join(out_dir, "ur5v")
+    os.makedirs(folder, exist_ok=True)
+    with open(os.path.join(SOURCE, "data", "robots", "ur5", "ur5.urdf")) as f:
+        urdf = f.read()
+    blocks = re.findall(r"<collision>.*?</collision>", urdf, re.S)
+    for k, block in enumerate(blocks):
+        visual = block.replace("<collision>", "<visual>").replace("</collision>", "</visual>")
+        if k == 0:
+            visual = re.sub(r'filename="[^"]+"', 'filename="package://ur_description/meshes/ur5/visual/gone.dae"', visual)
+        urdf = urdf.replace(block, block + "\n    " + visual, 1)
+    with open(os.path.join(folder, "ur5.urdf"), "w") as f:
+        f.write(urdf)
+    with open(os.path.join(SOURCE, "data", "robots", "ur5.json")) as f:
+        config = json.load(f)
+    config["urdf"] = "ur5.urdf"
+    config["package_path"] = [os.path.join(SOURCE, "data", "robots", "ur5")]
+    path = os.path.join(folder, "ur5v.json")
+    with open(path, "w") as f:
+        json.dump(config, f)
+    return path, len(blocks) - 1
+
+
 def write_lines(path, rows):
     with open(path, "w") as f:
         for r in rows:
@@ -275,6 +301,15 @@ def main():
     ur5_page = os.path.join(out_dir, "ur5.html")
     run([tool, "--robot", "ur5", "--results", write_lines(os.path.join(out_dir, "ur5.jsonl"), [
         trajectory_result("u", 1, ur5_home, ur5_other)]), "--out", ur5_page])
+    ur5v_config, ur5v_visuals = ur5_with_visuals(out_dir)
+    ur5v_page = os.path.join(out_dir, "ur5v.html")
+    ur5v_run = subprocess.run([tool, "--robot", ur5v_config, "--results", os.path.join(out_dir, "ur5.jsonl"),
+                               "--out", ur5v_page], capture_output=True, text=True)
+    check(ur5v_run.returncode == 0 and f"({ur5v_visuals} visuals)" in ur5v_run.stdout
+          and "warning" in ur5v_run.stderr and "gone.dae" in ur5v_run.stderr
+          and "the link is drawn from its collision geometry" in ur5v_run.stderr,
+          f"UR5 with visuals: {ur5v_visuals} read, the missing one a warning ({ur5v_run.stdout.strip()} "
+          f"{ur5v_run.stderr.strip()})")
     no_trajectories = os.path.join(out_dir, "none.html")
     bare = trajectory_result("a", 1, READY, OTHER)
     del bare["trajectory"]
@@ -334,6 +369,11 @@ def main():
         check(state.get("robotMeshes") == "7" and state.get("robotShapes") == "8",
               f"UR5 page: its 7 mesh links drawn as their meshes, the 8th shape as it is ({state})")
         nonblank_robot(browser, os.path.join(out_dir, "ur5.png"), "UR5 page")
+
+        state = open_page(browser, ur5v_page, "UR5 page with visuals")
+        check(state.get("robotVisuals") == str(ur5v_visuals) and state.get("robotShapes") == "8",
+              f"UR5 page with visuals: every readable visual drawn, the base from its collision mesh ({state})")
+        nonblank_robot(browser, os.path.join(out_dir, "ur5v.png"), "UR5 page with visuals")
 
         state = open_page(browser, only_failed, "failed-only page")
         text = browser.evaluate("document.body.innerText")
