@@ -205,6 +205,25 @@ TEST(Registry, SetupRefusesAContextWithoutWhatThePlannerNeeds) {
             "planner: sst needs a sampling box of 7 joints");
 }
 
+// A solve before any setup, or after a setup that failed, is one clear error naming the
+// planner, for every library planner (built in or not).
+TEST(Registry, SolveBeforeSetupIsAClearError) {
+  static const Scene scene("empty");
+  const PlanningContext no_bundle{scene.sim};
+  SimulatorWorkspace ws(scene.sim);
+  PlanningProblem problem;
+  problem.start = JointVector::Zero(7);
+  problem.goal.q = problem.start;
+  for (const std::string& name : planner_names()) {
+    std::unique_ptr<Planner> planner = make_planner(name, {});
+    EXPECT_EQ(message_of([&] { planner->solve(problem, ws); }), name + ": solve before setup");
+    if (name == "boe") {
+      EXPECT_NE(message_of([&] { planner->setup(no_bundle); }), "");
+      EXPECT_EQ(message_of([&] { planner->solve(problem, ws); }), "boe: solve before setup");
+    }
+  }
+}
+
 // ---- validate_problem ----------------------------------------------------------------------
 
 const Scene& table() {

@@ -314,7 +314,7 @@
   }
   const zero = robot.joints.map(() => 0);
   mainRobot.setQ(zero);
-  if (robot.shapes.length === 0) say('The robot has no collision geometry to draw.');
+  if (drawnShapes.length === 0) say('The robot has no geometry to draw (no visual or collision elements).');
 
   // ---- Trajectories and failed queries --------------------------------------------------
   const results = data.results;

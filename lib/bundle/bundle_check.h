@@ -7,6 +7,7 @@
 #pragma once
 
 #include <array>
+#include <cassert>
 #include <cstdint>
 #include <string>
 
@@ -24,6 +25,7 @@ struct BundleArrays {
   // The elements of dataset `id` (its table type is T), or null.
   template <typename T>
   const T* of(BundleDatasetId id) const {
+    assert(bundle_dataset_spec(id).type == element_type_of<T>());
     return static_cast<const T*>(data[static_cast<size_t>(id)]);
   }
   void set(BundleDatasetId id, const void* array) { data[static_cast<size_t>(id)] = array; }

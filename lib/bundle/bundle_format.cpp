@@ -144,16 +144,20 @@ ConstBundleArrayRef bundle_array(const Bundle& b, BundleDatasetId id) {
                     bundle_array(const_cast<Bundle&>(b), id));
 }
 
-bool bundle_has(const Bundle& b, const BundleDatasetSpec& spec) {
+bool present_with(const BundleDatasetSpec& spec, bool perturbation, bool transfer) {
   switch (spec.presence) {
     case Presence::Always:
       return true;
     case Presence::Perturbation:
-      return b.perturbation.present;
+      return perturbation;
     case Presence::Transfer:
-      return b.perturbation.present && b.perturbation.has_transfer;
+      return perturbation && transfer;
   }
   return false;
+}
+
+bool bundle_has(const Bundle& b, const BundleDatasetSpec& spec) {
+  return present_with(spec, b.perturbation.present, b.perturbation.has_transfer);
 }
 
 }  // namespace lazyboe

@@ -8,6 +8,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <string>
+#include <type_traits>
 #include <variant>
 #include <vector>
 
@@ -38,9 +39,19 @@ enum class BundleDatasetId {
   TransferMaxError,
   PLazyPropTransfer,
 };
-constexpr size_t kBundleDatasetCount = 20;
+constexpr size_t kBundleDatasetCount = static_cast<size_t>(BundleDatasetId::PLazyPropTransfer) + 1;
 
 enum class ElementType { F64, U64, F32 };
+// The element type of T (double, uint64_t, float).
+template <typename T>
+constexpr ElementType element_type_of() {
+  if constexpr (std::is_same_v<T, double>) return ElementType::F64;
+  if constexpr (std::is_same_v<T, float>) return ElementType::F32;
+  static_assert(
+      std::is_same_v<T, double> || std::is_same_v<T, float> || std::is_same_v<T, uint64_t>,
+      "bundle datasets hold double, float or uint64_t");
+  return ElementType::U64;
+}
 const char* element_type_name(ElementType type);  // "float64", "uint64", "float32"
 
 // The first dimension: the edges N, N + 1 (offsets), or the rows an offset dataset indexes (the
@@ -84,6 +95,9 @@ BundleArrayRef bundle_array(Bundle& bundle, BundleDatasetId id);
 using ConstBundleArrayRef = std::variant<const std::vector<double>*, const std::vector<uint64_t>*,
                                          const std::vector<float>*>;
 ConstBundleArrayRef bundle_array(const Bundle& bundle, BundleDatasetId id);
+// Whether a dataset is there when the file has a perturbation analysis (or not) and its
+// transfer statistics (or not).
+bool present_with(const BundleDatasetSpec& spec, bool perturbation, bool transfer);
 // Whether the bundle holds the dataset (its group is there).
 bool bundle_has(const Bundle& bundle, const BundleDatasetSpec& spec);
 

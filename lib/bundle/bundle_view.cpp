@@ -85,15 +85,7 @@ const T* BundleView::attach(long file, const std::string& dataset,
 }
 
 bool BundleView::holds(const BundleDatasetSpec& spec) const {
-  switch (spec.presence) {
-    case Presence::Always:
-      return true;
-    case Presence::Perturbation:
-      return has_perturbation_;
-    case Presence::Transfer:
-      return has_transfer_;
-  }
-  return false;
+  return present_with(spec, has_perturbation_, has_transfer_);
 }
 
 void BundleView::attach_datasets(long file, const BundleRows& rows, bool allow_mmap) {

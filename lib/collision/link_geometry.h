@@ -25,8 +25,8 @@ struct MeshSettings {
 };
 
 // Appends the collision bodies of `link` (model link `link_index`) to model.geometry.bodies
-// and the mesh files it read to model.resource_files; mesh URIs are resolved from
-// model.urdf_path and model.package_path (resource_path.h). Throws Error("<urdf>: link 'l'
+// and the mesh files it read to model.files.resources; mesh URIs are resolved from
+// model.files.urdf and model.files.package_path (resource_path.h). Throws Error("<urdf>: link 'l'
 // collision k: ...") for a missing, unreadable, empty, flat or non-mesh file, a package that is
 // not on the path, and a primitive without size.
 void add_link_collision_bodies(RobotModel& model, const urdf::Link& link, int link_index,

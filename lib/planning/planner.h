@@ -92,19 +92,27 @@ struct PlannerIdentity {
 
 // The base of the library's planners (as OMPL's base::Planner keeps its name and parameters):
 // the parameter values the registry checked and completed, the identity its PlannerInfo
-// declared, and the context of the last setup. A planner derived from it implements setup
-// (checks, then set_context) and solve.
+// declared, and the context of the last setup. A planner derived from it implements prepare
+// (setup's checks) and solve.
 class DeclaredPlanner : public Planner {
  public:
   DeclaredPlanner(const ParameterValues& values, PlannerIdentity identity)
       : values_(values), identity_(std::move(identity)) {}
+
+  using Planner::setup;  // keeps the deleted temporary overload visible
+  // Runs prepare (throws Error naming what the context lacks), then keeps the context.
+  void setup(const PlanningContext& context) final {
+    prepare(context);
+    context_ = &context;
+  }
 
   const std::string& name() const { return identity_.name; }
   const PlannerNeeds& needs() const { return identity_.needs; }
 
  protected:
   const ParameterValues& values() const { return values_; }
-  void set_context(const PlanningContext& context) { context_ = &context; }
+  // What setup checks and resolves of the context (what the planner needs of it).
+  virtual void prepare(const PlanningContext& /*context*/) {}
   // The context of the last setup; throws Error("<name>: solve before setup") before any.
   const PlanningContext& context() const;
 

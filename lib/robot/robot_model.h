@@ -78,7 +78,8 @@ struct ControllerGains {
   bool friction_feedforward = true;
 };
 
-// The files a robot was read from: together its identity (a bundle's robot_hash).
+// The files a robot was read from (the config, the URDF and its resources are its identity: a
+// bundle's robot_hash).
 struct RobotFiles {
   std::string config;                     // the robot config
   std::string urdf;                       // the URDF it names

@@ -143,7 +143,9 @@ JointVector typical_inertia_configuration(const RobotModel& robot, uint64_t seed
   for (long s = 0; s < std::max(1L, samples); ++s) {
     for (int i = 0; i < n; ++i) q[i] = rng.uniform(robot.region.lower[i], robot.region.upper[i]);
     qs.push_back(q);
-    diagonals.push_back(mass_matrix(robot, data, q).diagonal().array().log().matrix());
+    // M_ii > 0 for a model that loads (its mass matrix is checked positive definite); the
+    // floor keeps the log finite all the same.
+    diagonals.push_back(mass_matrix(robot, data, q).diagonal().array().max(1e-300).log().matrix());
   }
   JointVector median(n);
   std::vector<double> column(qs.size());

@@ -51,14 +51,13 @@ class OmplPlanner final : public DeclaredPlanner {
  public:
   using DeclaredPlanner::DeclaredPlanner;
 
-  void setup(const PlanningContext& context) override {
+  void prepare(const PlanningContext& context) override {
     if (!ompl_available()) {
       fail("planner", "'" + name() +
                           "' is not available: lazyboe was built without OMPL (install "
                           "libompl-dev and rebuild)");
     }
     check_sampling_box(context, name());
-    set_context(context);
   }
 
   PlanResult solve(const PlanningProblem& problem, SimulatorWorkspace& ws, RolloutPool*) override {

@@ -135,10 +135,10 @@ class BundlePlanner : public DeclaredPlanner {
  public:
   using DeclaredPlanner::DeclaredPlanner;
 
-  void setup(const PlanningContext& context) final {
-    theta_ = bundle_planner_setup(context, values(), name(), needs().perturbation);
+  void prepare(const PlanningContext& context) final {
+    const double theta = bundle_planner_setup(context, values(), name(), needs().perturbation);
     check_context(context);
-    set_context(context);
+    theta_ = theta;  // only once every check passed
   }
 
   PlanResult solve(const PlanningProblem& problem, SimulatorWorkspace& ws,

@@ -91,10 +91,7 @@ class TreePlanner : public DeclaredPlanner {
  public:
   using DeclaredPlanner::DeclaredPlanner;
 
-  void setup(const PlanningContext& context) final {
-    check_sampling_box(context, name());
-    set_context(context);
-  }
+  void prepare(const PlanningContext& context) final { check_sampling_box(context, name()); }
 
   PlanResult solve(const PlanningProblem& problem, SimulatorWorkspace& ws, RolloutPool*) final {
     return search(context(), ws, problem);
