@@ -98,8 +98,9 @@ BundleArrays arrays_of(const Bundle& b) {
   BundleArrays a;
   a.edges = b.size();
   a.dof = static_cast<uint64_t>(b.dof());
-  a.knot_rows = a.dof ? b.knots.size() / a.dof : 0;
-  a.sample_rows = a.dof ? b.sample_q.size() / a.dof : 0;
+  const BundleRows rows = bundle_rows(b);
+  a.knot_rows = rows.knots;
+  a.sample_rows = rows.samples;
   a.perturbations = b.perturbation.present ? b.perturbation.perturbations : 0;
   for (const BundleDatasetSpec& spec : bundle_datasets()) {
     if (!bundle_has(b, spec)) continue;

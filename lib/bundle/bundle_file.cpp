@@ -208,15 +208,6 @@ void expect_shape(const std::string& where, hid_t file, const char* name,
                     h5::shape_string(expected) + " (" + meaning + ")");
 }
 
-// Rows of a (rows x dof) dataset whose row count is free.
-uint64_t rows_of(const std::string& where, hid_t file, const char* name, uint64_t dof) {
-  const std::vector<uint64_t> found = h5::dataset_shape(where, file, name);
-  if (found.size() != 2 || found[1] != dof)
-    fail(where, std::string(name) + ": shape " + h5::shape_string(found) + ", expected rows x " +
-                    str(dof) + " (rows x dof)");
-  return found[0];
-}
-
 // A dataset with its checksum: "fnv1a64:<16 hex digits>" of its raw (little-endian) bytes, as
 // the attribute `checksum` (the layout stays contiguous and mappable).
 template <class T>
@@ -243,11 +234,6 @@ void write_perturbation_group(const std::string& tmp, hid_t file, const Perturba
       "start + d, d = r u: u uniform on the unit sphere, r uniform in (0, theta]");
 }
 
-BundleRows rows_of(const Bundle& b) {
-  const uint64_t dof = static_cast<uint64_t>(b.dof());
-  return {b.size(), b.knots.size() / dof, b.sample_q.size() / dof};
-}
-
 // Every dataset the bundle holds, in the table's order.
 void write_datasets(const std::string& tmp, hid_t file, const Bundle& b) {
   h5::create_group(tmp, file, "/edges");
@@ -259,7 +245,7 @@ void write_datasets(const std::string& tmp, hid_t file, const Bundle& b) {
     if (spec.presence != Presence::Always && !std::exchange(group_written, true))
       write_perturbation_group(tmp, file, b.perturbation);
     const std::vector<uint64_t> dims =
-        dataset_shape(spec, rows_of(b), static_cast<uint64_t>(b.dof()));
+        dataset_shape(spec, bundle_rows(b), static_cast<uint64_t>(b.dof()));
     std::visit([&](const auto* data) { write_checked(tmp, file, spec.path, *data, dims); },
                bundle_array(b, spec.id));
   }
@@ -291,7 +277,7 @@ void check_bundle(const Bundle& b, const std::string& where) {
   if (b.sample_q.size() % dof != 0)
     fail(where, "bundle.sample_q: " + str(b.sample_q.size()) +
                     " values, not a multiple of dof = " + str(dof));
-  const BundleRows rows = rows_of(b);
+  const BundleRows rows = bundle_rows(b);
   for (const BundleDatasetSpec& spec : bundle_datasets()) {
     if (!bundle_has(b, spec)) continue;
     const size_t found =
@@ -353,8 +339,8 @@ Bundle read_bundle(const std::string& path) {
   b.header = read_header(path, file, &n);
   const uint64_t dof = static_cast<uint64_t>(b.header.dof);
 
-  const uint64_t k = rows_of(path, file, ds::knots, dof);
-  const uint64_t s = rows_of(path, file, ds::sample_q, dof);
+  const uint64_t k = rows_by_dof(path, file, ds::knots, dof);
+  const uint64_t s = rows_by_dof(path, file, ds::sample_q, dof);
   if (h5::exists(file, ds::perturbation)) read_perturbation_group(path, file, b.perturbation);
   b.perturbation.has_transfer = b.perturbation.present && has_transfer_datasets(path, file);
   const BundleRows rows{n, k, s};
@@ -378,6 +364,14 @@ Bundle read_bundle(const std::string& path) {
   }
   check_bundle_arrays(arrays_of(b), path);
   return b;
+}
+
+uint64_t rows_by_dof(const std::string& where, hid_t file, const char* name, uint64_t dof) {
+  const std::vector<uint64_t> found = h5::dataset_shape(where, file, name);
+  if (found.size() != 2 || found[1] != dof)
+    fail(where, std::string(name) + ": shape " + h5::shape_string(found) + ", expected rows x " +
+                    str(dof) + " (rows x dof)");
+  return found[0];
 }
 
 bool has_transfer_datasets(const std::string& where, hid_t file) {

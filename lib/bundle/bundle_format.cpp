@@ -66,6 +66,11 @@ const BundleDatasetSpec& bundle_dataset_spec(BundleDatasetId id) {
   return bundle_datasets()[static_cast<size_t>(id)];
 }
 
+BundleRows bundle_rows(const Bundle& b) {
+  const uint64_t dof = b.dof() > 0 ? static_cast<uint64_t>(b.dof()) : 1;
+  return {b.size(), b.knots.size() / dof, b.sample_q.size() / dof};
+}
+
 uint64_t dataset_rows(const BundleDatasetSpec& spec, const BundleRows& rows) {
   switch (spec.rows) {
     case RowRule::Edges:

@@ -81,6 +81,8 @@ const BundleDatasetSpec& bundle_dataset_spec(BundleDatasetId id);
 struct BundleRows {
   uint64_t edges = 0, knots = 0, samples = 0;
 };
+// A bundle in memory's row counts (knots and samples from their sizes and dof).
+BundleRows bundle_rows(const Bundle& bundle);
 uint64_t dataset_rows(const BundleDatasetSpec& spec, const BundleRows& rows);
 // Its shape in the file: {rows} or {rows, dof}.
 std::vector<uint64_t> dataset_shape(const BundleDatasetSpec& spec, const BundleRows& rows,

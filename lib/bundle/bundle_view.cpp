@@ -35,15 +35,6 @@ std::string stored_checksums(const std::string& path, long file,
   return out;
 }
 
-// Rows of a (rows x dof) dataset ("K x dof"): the row count is free.
-uint64_t rows_by_dof(const std::string& path, long file, const char* name, uint64_t dof,
-                     const char* rows) {
-  const std::vector<uint64_t> shape = h5::dataset_shape(path, file, name);
-  if (shape.size() != 2 || shape[1] != dof)
-    fail(path, std::string(name) + ": expected " + rows + " x dof");
-  return shape[0];
-}
-
 }  // namespace
 
 CommandProfile BundleView::command(size_t e) const {
@@ -139,10 +130,10 @@ BundleView BundleView::open(const std::string& path, bool allow_mmap) {
   h5::File file = h5::open_file(path);
   v.states_checksum_ = stored_checksums(path, file, {ds::q0, ds::qf});
   BundleRows rows{n, 0, 0};
-  rows.knots = rows_by_dof(path, file, ds::knots, dof, "K");
+  rows.knots = rows_by_dof(path, file, ds::knots, dof);
   // The sample offsets are checked like every reader checks them (the samples' values are
   // never used to plan: read_bundle and --verify check them; the workspace index reads them).
-  rows.samples = rows_by_dof(path, file, ds::sample_q, dof, "S");
+  rows.samples = rows_by_dof(path, file, ds::sample_q, dof);
   if (h5::exists(file, ds::perturbation)) {
     h5::Group g(H5Gopen2(file, ds::perturbation, H5P_DEFAULT));
     if (!g.valid()) fail(path, std::string(ds::perturbation) + ": cannot open group");

@@ -176,4 +176,8 @@ DatasetLocation dataset_location(const std::string& where, hid_t file, const std
 // the missing one. read_bundle and BundleView::open both ask this.
 bool has_transfer_datasets(const std::string& where, hid_t file);
 
+// The row count of an open bundle file's (rows x dof) dataset, whose rows are free (the knots,
+// the trajectory samples); any other shape is an Error naming the dataset and its shape.
+uint64_t rows_by_dof(const std::string& where, hid_t file, const char* name, uint64_t dof);
+
 }  // namespace lazyboe

@@ -73,7 +73,8 @@ json draft_config(const RobotSetupOptions& o, const std::string& base, const std
 // ka: the joint inertia M_ii at the configuration of typical inertia; kv: the velocity loop's time
 // constant M_ii / kv at most `time_constant` at the largest sampled M_ii, and kv T / M_ii at most
 // 0.3 at the smallest (the discrete loop's stability at the control period T).
-json controller_gains(const RobotModel& robot, const RobotSetupOptions& o) {
+json controller_gains(const RobotModel& robot, const RobotSetupOptions& o,
+                      const JointVector& typical) {
   RobotData data(robot);
   const int n = robot.dof;
   JointVector lo = JointVector::Constant(n, INFINITY), hi = JointVector::Constant(n, 0);
@@ -85,7 +86,6 @@ json controller_gains(const RobotModel& robot, const RobotSetupOptions& o) {
     lo = lo.cwiseMin(diagonal);
     hi = hi.cwiseMax(diagonal);
   }
-  const JointVector typical = typical_inertia_configuration(robot, o.seed, o.inertia_samples);
   const JointVector ka = mass_matrix(robot, data, typical).diagonal();
   json kv = json::array(), ka_json = json::array();
   for (int i = 0; i < n; ++i) {
@@ -160,13 +160,12 @@ JointVector typical_inertia_configuration(const RobotModel& robot, uint64_t seed
   return qs[best];
 }
 
-std::vector<StepCheck> check_velocity_steps(const RobotModel& robot, uint64_t seed, long samples) {
+std::vector<StepCheck> check_velocity_steps(const RobotModel& robot, const JointVector& start) {
   CollisionModel collision = build_collision_model(robot, Environment{});
   collision.self_pairs.clear();  // the gains are checked, not the geometry
   const Simulator sim(robot, collision, SimulationOptions{});
   SimulatorWorkspace ws(sim);
   const int n = robot.dof;
-  const JointVector start = typical_inertia_configuration(robot, seed, samples);
   std::vector<StepCheck> steps;
   std::vector<double> knots(5 * n), ticks;
   for (int i = 0; i < n; ++i) {
@@ -200,7 +199,10 @@ RobotSetup make_robot_config(const RobotSetupOptions& o) {
   RobotSetup setup;
   setup.config = draft_config(o, base, tip, chain_joints(o.urdf_path, base, tip));
   const RobotModel draft = robot_from_json(nlohmann::json::parse(setup.config.dump()), o.out_path);
-  setup.config["controller"] = controller_gains(draft, o);
+  // Where the gains' feed-forward is taken and the steps start (the same inertia in the draft
+  // and the final model: only the controller and the allowed pairs are added).
+  const JointVector typical = typical_inertia_configuration(draft, o.seed, o.inertia_samples);
+  setup.config["controller"] = controller_gains(draft, o, typical);
   std::set<std::pair<std::string, std::string>> pairs;
   int adjacent = 0, always = 0, from_srdf = 0;
   for (const LinkPairStats& p : derive_allowed_pairs(draft, o.pair_samples, o.seed).pairs) {
@@ -216,7 +218,7 @@ RobotSetup make_robot_config(const RobotSetupOptions& o) {
   }
   for (const auto& [a, b] : pairs) setup.config["collision"]["allowed_pairs"].push_back({a, b});
   const RobotModel robot = robot_from_json(nlohmann::json::parse(setup.config.dump()), o.out_path);
-  setup.steps = check_velocity_steps(robot, o.seed, o.inertia_samples);
+  setup.steps = check_velocity_steps(robot, typical);
   setup.notes = setup_notes(robot, srdf);
   char line[300];
   std::snprintf(line, sizeof line,

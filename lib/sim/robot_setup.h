@@ -66,8 +66,8 @@ RobotSetup make_robot_config(const RobotSetupOptions& options);
 JointVector typical_inertia_configuration(const RobotModel& robot, uint64_t seed, long samples);
 
 // Simulates, for each joint in turn, a velocity step of 0.3 x its limit (0.25 s minimum-jerk
-// ramps, 0.5 s held) from the configuration of typical inertia with the other joints commanded
-// still, checking limits but not collisions.
-std::vector<StepCheck> check_velocity_steps(const RobotModel& robot, uint64_t seed, long samples);
+// ramps, 0.5 s held) from `start` (init: the configuration of typical inertia) with the other
+// joints commanded still, checking limits but not collisions.
+std::vector<StepCheck> check_velocity_steps(const RobotModel& robot, const JointVector& start);
 
 }  // namespace lazyboe
