@@ -169,6 +169,8 @@ bool is_bundle_planner(const std::string& planner) {
 ParameterValues searching(const std::string& planner, ParameterValues values) {
   const PlannerInfo* info = find_planner(planner);
   if (info && info->parameter("direct")) values.set("direct", 0);
+  if (info && info->parameter("connect_radius") && !values.has("connect_radius"))
+    values.set("connect_radius", 0);
   return values;
 }
 

@@ -14,6 +14,7 @@
 #include "lazyboe/common/error.h"
 #include "lazyboe/common/hash.h"
 #include "lazyboe/planning/edge_index_file.h"
+#include "lazyboe/planning/planners/neighbour_memo.h"
 #include "test_util.h"
 
 namespace lazyboe {
@@ -88,6 +89,38 @@ TEST(EdgeIndex, FindsWhatAScanFindsForStartsAndEnds) {
     const EdgeIndex index(v, point);
     EXPECT_EQ(index.point(), point);
     expect_scan_results(v, index);
+  }
+}
+
+// lazysp's memo of its radius queries answers as the index, for states asked before (from the
+// memo, bit for bit the same state) and new ones, also after it filled up and started again.
+TEST(EdgeIndex, TheMemoOfRadiusQueriesAnswersAsTheIndex) {
+  const BundleView v =
+      BundleView::from_memory(std::make_shared<const Bundle>(awkward_bundle(3000, 4)), "mem");
+  const EdgeIndex index(v);
+  for (const size_t capacity : {size_t{1} << 20, size_t{40}}) {
+    NeighbourMemo memo(index, 0.7, 7, capacity);
+    std::mt19937_64 rng(5);
+    std::uniform_real_distribution<double> u(-1, 1);
+    std::vector<std::vector<double>> states;
+    for (int i = 0; i < 200; ++i) {
+      if (i % 2 == 1) {  // a state asked before, as the lazy search's next round asks it
+        states.push_back(states[rng() % states.size()]);
+      } else {
+        states.emplace_back(7);
+        for (int k = 0; k < 7; ++k) states.back()[k] = v.q0(i)[k] + 0.1 * u(rng);
+      }
+      const NeighbourMemo::Span got = memo.within(states.back().data());
+      std::vector<uint32_t> ids(got.edges, got.edges + got.count), expected;
+      for (const auto& [e, d2] : scan(v, EdgePoint::Start, states.back().data(), 0.7))
+        expected.push_back(e);
+      ASSERT_EQ(ids, expected) << "state " << i << ", memo of " << capacity << " ids";
+    }
+    if (capacity > 40) {
+      EXPECT_EQ(memo.hits(), 100u);  // every state asked again
+    } else {
+      EXPECT_LT(memo.hits(), 100u);  // it started again when full
+    }
   }
 }
 

@@ -682,6 +682,37 @@ TEST(LazySp, AGoalBeyondTheBundlesCoverageIsSolvedByTheGrowth) {
             << r.counters.simulations << " simulations, " << r.time_to_first_solution << " s\n";
 }
 
+// A joint goal whose tolerance (1 cm of joint motion) no bundle edge or random command lands in:
+// lazysp's candidates end within candidate_radius of it, and the direct command from a real
+// state within connect_radius, corrected, does (found_by "connection", its last step). Without
+// the connection nothing reaches it.
+TEST(LazySp, ANarrowJointGoalIsReachedByTheDirectCommandFromANearState) {
+  const Fixture& f = fixture();
+  const PlanningContext context = session_context(f, f.sim);
+  SimulatorWorkspace ws(f.sim);
+  PlanningProblem p = library_problem(f.a, f.c, 10);
+  p.goal.tolerance = 0.01;
+  p.termination.stop_at_first = true;
+  const PlanResult r =
+      plan(context, ws, "lazysp", searching("lazysp", {{"connect_radius", 1.0}}), p);
+  ASSERT_TRUE(r.success) << r.failure;
+  EXPECT_EQ(r.found_by, "connection");
+  ASSERT_GE(r.best_path.size(), 2u);
+  EXPECT_EQ(r.best_path.back().bundle_edge, -1);  // the connection
+  EXPECT_GE(r.best_path.front().bundle_edge, 0);  // from a validated candidate
+  const Trajectory t = expect_revalidated(f, f.sim, p, r);
+  EXPECT_LE((t.q.back() - p.goal.q).norm(), p.goal.tolerance);
+  std::cout << "[ lazysp  ] narrow goal: " << r.best_path.size() << " steps, "
+            << r.counters.simulations << " simulations\n";
+
+  p.termination.budget = 1;
+  const PlanResult without = plan(context, ws, "lazysp", searching("lazysp"), p);
+  EXPECT_NE(without.found_by, "connection");
+  EXPECT_FALSE(without.success && without.best_path.back().bundle_edge >= 0 &&
+               without.counters.simulations <= r.counters.simulations)
+      << "the bundle alone reaches the narrow goal as cheaply: the test shows nothing";
+}
+
 // An obstacle the bundle never saw, on the way of lazysp's first path: the same first
 // candidate (the lazy search simulates nothing) now collides when simulated, and lazysp plans
 // around it instead of returning it.

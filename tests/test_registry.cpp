@@ -101,8 +101,9 @@ TEST(Registry, NamesAndLookups) {
   EXPECT_EQ(std::set<std::string>(all.begin(), all.end()),
             (std::set<std::string>{"theta", "lazy_model", "goal_bias", "selection_radius",
                                    "pruning_ratio", "epsilon", "resolution", "risk_weight",
-                                   "edge_penalty", "expansion_limit", "mark_weight", "direct"}));
-  EXPECT_EQ(all.size(), 12u);  // each once
+                                   "edge_penalty", "expansion_limit", "mark_weight", "direct",
+                                   "connect_radius", "candidate_radius"}));
+  EXPECT_EQ(all.size(), 14u);  // each once
 }
 
 // The refusals only: a planner registered here would stay for the other tests of a process that

@@ -168,8 +168,17 @@ class SearchState {
     simulations = 0;
     const auto [nearest, distance] = problem_.goal.nearest_configuration(q);
     if (!nearest || distance > kGoalConnectRadius) return std::nullopt;
+    return connection(q, *nearest, simulations);
+  }
+
+  // The direct command from q to `target`, corrected to land in the goal region
+  // (direct_step_to), when it simulates valid; `simulations` gets how many it ran (all counted
+  // here).
+  std::optional<PathStep> connection(const JointVector& q, const JointVector& target,
+                                     int& simulations) {
+    simulations = 0;
     std::optional<PathStep> step =
-        direct_step_to(ctx_.sim, ws_, ctx_.command, q, *nearest, &problem_.goal, &simulations);
+        direct_step_to(ctx_.sim, ws_, ctx_.command, q, target, &problem_.goal, &simulations);
     if (!step) return std::nullopt;
     count_simulations(simulations, *step->outcome);
     if (!step->outcome->valid()) return std::nullopt;

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "lazyboe/planning/planners/bundle_search.h"
+#include "lazyboe/planning/planners/neighbour_memo.h"
 #include "lazyboe/planning/planners/tree_search.h"
 #include "lazyboe/sim/random.h"
 
@@ -39,10 +40,14 @@ constexpr size_t kMarkedSearchLimit = 1000;
 // table bundle, 5 s: factor 1.0 / 1.3 / 1.5 solved 96 / 99 / 100 of 100 (table, seed 7777) and
 // 92 / 97 / 98 (shelf, seed 6464), medians 30 / 12 / 11 ms (table).
 constexpr double kTiltWidening = 1.5;
+// Edge ids the memo of the lazy search's radius queries keeps (4 bytes each, with about 2 more
+// bytes per id for its states and slots) before it starts again empty.
+constexpr size_t kMemoEdges = size_t{4} << 20;
 
 // The declared parameters' values (lazysp_planner_info has their defaults).
 struct Settings {
-  double theta, epsilon, resolution, risk_weight, edge_penalty, goal_bias, mark_weight;
+  double theta, epsilon, resolution, risk_weight, edge_penalty, goal_bias, mark_weight,
+      connect_radius, candidate_radius;
   size_t expansion_limit;
   bool direct;
 };
@@ -80,7 +85,9 @@ class LazySpSearch {
                                 !solve.problem.goal.configurations.empty()),
         motions_(task_motions(ctx_)),
         neighbourhood_(set_.theta *
-                       (std::isfinite(ctx_.sim.end_effector.max_tilt) ? kTiltWidening : 1.0)) {}
+                       (std::isfinite(ctx_.sim.end_effector.max_tilt) ? kTiltWidening : 1.0)),
+        lazy_goal_radius_(lazy_goal_radius(set_, solve.problem.goal)),
+        memo_(*ctx_.index, neighbourhood_, ctx_.sim.robot.dof, kMemoEdges) {}
 
   PlanResult run();
 
@@ -100,6 +107,13 @@ class LazySpSearch {
   // A real node: the end of rollout r from `parent` (-1 and r.qf the start: the root).
   int add_real(const RolloutResult& r, int parent, int64_t edge, int command);
   void found(int node, const char* by);
+  // The radius of the lazy search's goal region around a joint goal: candidate_radius, from where
+  // a validated end tries the direct command to the goal (within connect_radius), and never
+  // less than the goal's tolerance.
+  static double lazy_goal_radius(const Settings& set, const Goal& goal) {
+    if (goal.kind != Goal::Kind::Joint || !(set.connect_radius > 0)) return goal.tolerance;
+    return std::max(goal.tolerance, std::min(set.candidate_radius, set.connect_radius));
+  }
   // The lazy search's goal. For a pose goal or goal set (with configurations found by inverse
   // kinematics): the joint distance to the nearest configuration, in the goal within theta of
   // one, from where a validated candidate's end connects (connect_to_goal): the search is then
@@ -108,7 +122,7 @@ class LazySpSearch {
   // goal's own heuristic and region.
   double lazy_h(const JointVector& q);
   bool lazy_in_goal(double h) const {
-    return aims_at_configurations_ ? h <= set_.theta : s_.in_goal(h);
+    return aims_at_configurations_ ? h <= set_.theta : h <= lazy_goal_radius_;
   }
   bool within_limits(const JointVector& q) const;
   // The edges' stored link motions when the world limits the link's speed or acceleration
@@ -139,6 +153,8 @@ class LazySpSearch {
             v.get("edge_penalty"),
             v.get("goal_bias"),
             v.get("mark_weight"),
+            v.get("connect_radius"),
+            v.get("candidate_radius"),
             static_cast<size_t>(v.get("expansion_limit")),
             v.get("direct") != 0};
   }
@@ -152,7 +168,9 @@ class LazySpSearch {
   Random rng_;
   const bool aims_at_configurations_;    // lazy_h
   const EdgeLinkMotion* const motions_;  // breaks_task
-  const double neighbourhood_;  // radius of a predicted state's edges: theta, wider under tilt
+  const double neighbourhood_;     // radius of a predicted state's edges: theta, wider under tilt
+  const double lazy_goal_radius_;  // lazy_in_goal's, for a joint goal
+  NeighbourMemo memo_;             // expand's radius queries, across rounds
   bool goal_covered_ = true;
   std::unordered_set<uint64_t> tried_;  // (real node, edge) pairs simulated, valid or not
   std::vector<PathStep> commands_;      // the growth's commands, by LazySpNode::command
@@ -179,11 +197,11 @@ PlanResult LazySpSearch::run() {
   at_start.qf = s_.problem().start;
   add_real(at_start, -1, -1, -1);
   // A predicted state x + qf(e) - q0(e), with x within the neighbourhood (theta) of q0(e), lies
-  // as near qf(e): a joint goal farther than that + tolerance from every edge end is beyond the
-  // lazy search, and only the growth can reach it.
+  // as near qf(e): a joint goal farther than that + the lazy goal radius from every edge end is
+  // beyond the lazy search, and only the growth can reach it.
   const Goal& goal = s_.problem().goal;
   if (goal.kind == Goal::Kind::Joint)
-    goal_covered_ = edge_ends_near(ctx_, goal.q, neighbourhood_ + goal.tolerance, neighbours_);
+    goal_covered_ = edge_ends_near(ctx_, goal.q, neighbourhood_ + lazy_goal_radius_, neighbours_);
   while (!s_.should_stop()) {
     if (lazy_turn()) {
       lazy_round();
@@ -278,12 +296,13 @@ int LazySpSearch::expand(int p) {
   from_ = preds_[p].q;  // preds_ grows below
   const double g = preds_[p].g, length = preds_[p].length;
   const int real = preds_[p].real;
-  ctx_.index->within(from_.data(), neighbourhood_, neighbours_);
-  successors_ += neighbours_.size();
+  const NeighbourMemo::Span near = memo_.within(from_.data());
+  successors_ += near.count;
   const int n = bundle_.dof();
   int goal = -1;
   double goal_g = std::numeric_limits<double>::infinity();
-  for (const auto& [e, d2] : neighbours_) {
+  for (size_t k = 0; k < near.count; ++k) {
+    const uint32_t e = near.edges[k];
     // From a real state, an edge simulated before is known: its real end is a source itself.
     if (real >= 0 && tried_.count(key(real, e))) continue;
     step_ = Eigen::Map<const Eigen::VectorXd>(bundle_.qf(e), n) -
@@ -380,11 +399,20 @@ void LazySpSearch::grow() {
   }
 }
 
-// Pose goals and goal sets: the direct command from a new real node to the goal
-// (SearchState::goal_connection), counted as growth work. True when it reached the goal.
+// The direct command from a new real node to the goal, counted as growth work: for pose goals
+// and goal sets SearchState::goal_connection, for a joint goal from within connect_radius of it
+// (in clutter a random command or a bundle edge seldom ends in the goal's tolerance where the
+// straight way in is free). True when it reached the goal.
 bool LazySpSearch::connect_to_goal(int v) {
   int simulations = 0;
-  std::optional<PathStep> step = s_.goal_connection(s_.node(v).q, simulations);
+  const LazySpNode& node = s_.node(v);
+  const Goal& goal = s_.problem().goal;
+  std::optional<PathStep> step;
+  if (goal.kind != Goal::Kind::Joint) {
+    step = s_.goal_connection(node.q, simulations);
+  } else if (node.h <= set_.connect_radius) {
+    step = s_.connection(node.q, goal.q, simulations);
+  }
   growth_work_ += simulations;
   if (!step) return false;
   const RolloutResult outcome = *step->outcome;
@@ -494,6 +522,13 @@ PlannerInfo lazysp_planner_info() {
       real_parameter("mark_weight", 2.0, 0, false,
                      "rad of cost added per edge a scene other than the bundle's may block "
                      "(workspace index), in the first search of each round"),
+      real_parameter("connect_radius", 1.0, 0, false,
+                     "rad: a new real state this near a joint goal tries the direct command to "
+                     "it (0: never; pose goals and goal sets always try within 1 rad)"),
+      real_parameter("candidate_radius", 0.8, 0, false,
+                     "rad: the lazy search's candidates end this near a joint goal (at most "
+                     "connect_radius, at least the goal's tolerance; with connect_radius 0 the "
+                     "tolerance)"),
   };
   info.make = planner_factory<LazySp>(info);
   return info;
