@@ -98,7 +98,7 @@ TEST(EdgeIndex, TheMemoOfRadiusQueriesAnswersAsTheIndex) {
   const BundleView v =
       BundleView::from_memory(std::make_shared<const Bundle>(awkward_bundle(3000, 4)), "mem");
   const EdgeIndex index(v);
-  for (const size_t capacity : {size_t{1} << 20, size_t{40}}) {
+  for (const size_t capacity : {size_t{1} << 20, size_t{2000}}) {  // bytes
     NeighbourMemo memo(index, 0.7, 7, capacity);
     std::mt19937_64 rng(5);
     std::uniform_real_distribution<double> u(-1, 1);
@@ -114,9 +114,9 @@ TEST(EdgeIndex, TheMemoOfRadiusQueriesAnswersAsTheIndex) {
       std::vector<uint32_t> ids(got.edges, got.edges + got.count), expected;
       for (const auto& [e, d2] : scan(v, EdgePoint::Start, states.back().data(), 0.7))
         expected.push_back(e);
-      ASSERT_EQ(ids, expected) << "state " << i << ", memo of " << capacity << " ids";
+      ASSERT_EQ(ids, expected) << "state " << i << ", memo of " << capacity << " bytes";
     }
-    if (capacity > 40) {
+    if (capacity > 2000) {
       EXPECT_EQ(memo.hits(), 100u);  // every state asked again
     } else {
       EXPECT_LT(memo.hits(), 100u);  // it started again when full

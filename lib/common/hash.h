@@ -8,6 +8,15 @@
 
 namespace lazyboe {
 
+// A 64-bit key of several values, for hash tables in memory (joint-space cells and states):
+// start from kKeySeed and mix each value in. Not a content hash; it may change between versions.
+constexpr uint64_t kKeySeed = 0x9E3779B97F4A7C15ULL;
+inline uint64_t mix_key(uint64_t h, uint64_t value) {
+  h ^= value + 0x9E3779B97F4A7C15ULL + (h << 6) + (h >> 2);
+  h *= 0xBF58476D1CE4E5B9ULL;
+  return h ^ (h >> 31);
+}
+
 // Incremental FNV-1a 64 (offset basis 0xcbf29ce484222325, prime 0x100000001b3).
 class Fnv1a64 {
  public:

@@ -9,6 +9,7 @@
 #include <utility>
 #include <vector>
 
+#include "lazyboe/common/hash.h"
 #include "lazyboe/planning/planners/bundle_search.h"
 #include "lazyboe/planning/planners/neighbour_memo.h"
 #include "lazyboe/planning/planners/tree_search.h"
@@ -40,9 +41,9 @@ constexpr size_t kMarkedSearchLimit = 1000;
 // table bundle, 5 s: factor 1.0 / 1.3 / 1.5 solved 96 / 99 / 100 of 100 (table, seed 7777) and
 // 92 / 97 / 98 (shelf, seed 6464), medians 30 / 12 / 11 ms (table).
 constexpr double kTiltWidening = 1.5;
-// Edge ids the memo of the lazy search's radius queries keeps (4 bytes each, with about 2 more
-// bytes per id for its states and slots) before it starts again empty.
-constexpr size_t kMemoEdges = size_t{4} << 20;
+// Bytes the memo of the lazy search's radius queries may hold before it starts again empty
+// (a failing 5 s solve on the 100k table bundle expands about 10^5 states of tens of edges).
+constexpr size_t kMemoBytes = size_t{32} << 20;
 
 // The declared parameters' values (lazysp_planner_info has their defaults).
 struct Settings {
@@ -87,7 +88,7 @@ class LazySpSearch {
         neighbourhood_(set_.theta *
                        (std::isfinite(ctx_.sim.end_effector.max_tilt) ? kTiltWidening : 1.0)),
         lazy_goal_radius_(lazy_goal_radius(set_, solve.problem.goal)),
-        memo_(*ctx_.index, neighbourhood_, ctx_.sim.robot.dof, kMemoEdges) {}
+        memo_(*ctx_.index, neighbourhood_, ctx_.sim.robot.dof, kMemoBytes) {}
 
   PlanResult run();
 
@@ -395,14 +396,17 @@ void LazySpSearch::grow() {
   if (s_.in_goal(s_.node(c).h)) {
     found(c, "growth");
   } else {
+    const uint64_t before = s_.result().counters.simulations;
     connect_to_goal(c);
+    growth_work_ += static_cast<double>(s_.result().counters.simulations - before);
   }
 }
 
-// The direct command from a new real node to the goal, counted as growth work: for pose goals
-// and goal sets SearchState::goal_connection, for a joint goal from within connect_radius of it
-// (in clutter a random command or a bundle edge seldom ends in the goal's tolerance where the
-// straight way in is free). True when it reached the goal.
+// The direct command from a new real node to the goal (its simulations are the work of the
+// part that made the node: a lazy round counts every simulation of its validation, the growth
+// its own): for pose goals and goal sets SearchState::goal_connection, for a joint goal from
+// within connect_radius of it (in clutter a random command or a bundle edge seldom ends in the
+// goal's tolerance where the straight way in is free). True when it reached the goal.
 bool LazySpSearch::connect_to_goal(int v) {
   int simulations = 0;
   const LazySpNode& node = s_.node(v);
@@ -410,10 +414,9 @@ bool LazySpSearch::connect_to_goal(int v) {
   std::optional<PathStep> step;
   if (goal.kind != Goal::Kind::Joint) {
     step = s_.goal_connection(node.q, simulations);
-  } else if (node.h <= set_.connect_radius) {
+  } else if (set_.connect_radius > 0 && node.h <= set_.connect_radius) {
     step = s_.connection(node.q, goal.q, simulations);
   }
-  growth_work_ += simulations;
   if (!step) return false;
   const RolloutResult outcome = *step->outcome;
   commands_.push_back({-1, std::move(step->knots), step->command_duration});
@@ -465,12 +468,10 @@ bool LazySpSearch::within_limits(const JointVector& q) const {
 // A 64-bit hash of the cell's integer coordinates (two cells sharing a hash would merge: for a
 // round of a million states about one chance in 4 10^7, and then one state is lost).
 uint64_t LazySpSearch::cell(const JointVector& q) const {
-  uint64_t h = 0x9E3779B97F4A7C15ULL;
+  uint64_t h = kKeySeed;
   for (int i = 0; i < q.size(); ++i) {
     const auto c = static_cast<int64_t>(std::floor(q[i] / set_.resolution));
-    h ^= static_cast<uint64_t>(c) + 0x9E3779B97F4A7C15ULL + (h << 6) + (h >> 2);
-    h *= 0xBF58476D1CE4E5B9ULL;
-    h ^= h >> 31;
+    h = mix_key(h, static_cast<uint64_t>(c));
   }
   return h;
 }

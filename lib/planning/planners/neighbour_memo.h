@@ -11,6 +11,7 @@
 #include <utility>
 #include <vector>
 
+#include "lazyboe/common/hash.h"
 #include "lazyboe/planning/neighbour_index.h"
 
 namespace lazyboe {
@@ -23,9 +24,10 @@ class NeighbourMemo {
     size_t count;
   };
 
-  // `max_edges`: edge ids kept in all (4 bytes each) before the memo starts again empty.
-  NeighbourMemo(const EdgeIndex& index, double radius, int dof, size_t max_edges)
-      : index_(index), radius_(radius), dof_(dof), max_edges_(max_edges) {}
+  // `max_bytes`: about what the memo may hold (its edge ids, states and slots) before it
+  // starts again empty.
+  NeighbourMemo(const EdgeIndex& index, double radius, int dof, size_t max_bytes)
+      : index_(index), radius_(radius), dof_(dof), max_bytes_(max_bytes) {}
 
   // The edges whose start lies within the radius of q (EdgeIndex::within's ids, in its order).
   Span within(const double* q) {
@@ -55,7 +57,7 @@ class NeighbourMemo {
   };
 
   Span remember(uint64_t h, const double* q) {
-    if (edges_.size() + found_.size() > max_edges_) {  // full: start again
+    if (bytes(slots_.size() + 1, edges_.size() + found_.size()) > max_bytes_) {  // full: again
       slots_.clear();
       edges_.clear();
       states_.clear();
@@ -67,14 +69,17 @@ class NeighbourMemo {
     return {edges_.data() + e.first, e.count};
   }
 
+  // A state's share: its coordinates, its entry and about a hash-map node.
+  size_t bytes(size_t states, size_t ids) const {
+    return ids * sizeof(uint32_t) + states * (dof_ * sizeof(double) + sizeof(Entry) + 32);
+  }
+
   uint64_t hash(const double* q) const {
-    uint64_t h = 0x9E3779B97F4A7C15ULL;
+    uint64_t h = kKeySeed;
     for (int i = 0; i < dof_; ++i) {
       uint64_t bits;
       std::memcpy(&bits, q + i, sizeof bits);
-      h ^= bits + 0x9E3779B97F4A7C15ULL + (h << 6) + (h >> 2);
-      h *= 0xBF58476D1CE4E5B9ULL;
-      h ^= h >> 31;
+      h = mix_key(h, bits);
     }
     return h;
   }
@@ -82,7 +87,7 @@ class NeighbourMemo {
   const EdgeIndex& index_;
   const double radius_;
   const int dof_;
-  const size_t max_edges_;
+  const size_t max_bytes_;
   std::unordered_map<uint64_t, Entry> slots_;
   std::vector<uint32_t> edges_;
   std::vector<double> states_;
