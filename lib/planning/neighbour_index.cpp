@@ -114,6 +114,7 @@ class TreeBuilder {
 struct Search {
   const KdTreeArrays& tree;
   const double* rows;
+  bool leaf_ordered;  // row i is point order[i] (else row id is point id)
   int dof;
   const double* q;
   double r2, prune;  // prune: r2 with a margin, so that rounding in the bound never drops a point
@@ -122,14 +123,13 @@ struct Search {
 
   void leaf(const KdNode& n) const {
     for (uint32_t i = n.first; i < n.second; ++i) {
-      const uint32_t id = tree.order[i];
-      const double* p = rows + size_t{id} * dof;
+      const double* p = rows + size_t{leaf_ordered ? i : tree.order[i]} * dof;
       double d = 0;
       for (int k = 0; k < dof; ++k) {
         const double diff = q[k] - p[k];
         d += diff * diff;
       }
-      if (d < r2) out.emplace_back(id, d);
+      if (d < r2) out.emplace_back(tree.order[i], d);
     }
   }
 
@@ -229,6 +229,18 @@ struct EdgeIndex::Impl {
   int dof;
   KdTreeArrays arrays;
   std::shared_ptr<const void> storage;  // what `arrays` point into
+  // An index over the edge starts (the planners' neighbourhoods, queried thousands of times a
+  // solve) keeps its points again in leaf order, so that a leaf's scan reads contiguous memory
+  // instead of rows spread over the bundle: cache misses were most of a radius query's time.
+  // dof doubles per edge; the end index (goal coverage, a few queries a solve) reads the bundle.
+  std::vector<double> leaf_rows = {};
+
+  void order_rows(size_t count) {
+    if (rows == nullptr || point != EdgePoint::Start) return;
+    leaf_rows.resize(count * static_cast<size_t>(dof));
+    for (size_t i = 0; i < count; ++i)
+      std::copy_n(rows + size_t{arrays.order[i]} * dof, dof, leaf_rows.data() + i * dof);
+  }
 };
 
 EdgeIndex::EdgeIndex(const BundleView& bundle, EdgePoint point)
@@ -238,6 +250,7 @@ EdgeIndex::EdgeIndex(const BundleView& bundle, EdgePoint point)
   impl_->arrays = KdTreeArrays{built->nodes.data(), built->nodes.size(), built->order.data(),
                                built->lower.data(), built->upper.data()};
   impl_->storage = std::move(built);
+  impl_->order_rows(bundle.size());
 }
 
 EdgeIndex::EdgeIndex(const BundleView& bundle, EdgePoint point, const KdTreeArrays& arrays,
@@ -245,6 +258,7 @@ EdgeIndex::EdgeIndex(const BundleView& bundle, EdgePoint point, const KdTreeArra
     : impl_(std::make_unique<Impl>(
           Impl{point, point_rows(bundle, point), bundle.dof(), arrays, std::move(storage)})) {
   TreeCheck(arrays, impl_->rows, bundle.size(), bundle.dof(), where).run();
+  impl_->order_rows(bundle.size());
 }
 
 EdgeIndex::~EdgeIndex() = default;
@@ -258,7 +272,16 @@ void EdgeIndex::within(const double* q, double radius,
   const Impl& m = *impl_;
   if (m.rows == nullptr) return;
   const double r2 = radius * radius;
-  Search s{m.arrays, m.rows, m.dof, q, r2, r2 * (1 + 1e-9), {}, out};
+  const bool leaf_ordered = !m.leaf_rows.empty();
+  Search s{m.arrays,
+           leaf_ordered ? m.leaf_rows.data() : m.rows,
+           leaf_ordered,
+           m.dof,
+           q,
+           r2,
+           r2 * (1 + 1e-9),
+           {},
+           out};
   double bound = 0;
   for (int d = 0; d < m.dof; ++d) {
     const double gap = std::max({m.arrays.lower[d] - q[d], q[d] - m.arrays.upper[d], 0.0});
