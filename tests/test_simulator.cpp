@@ -204,6 +204,52 @@ TEST(Simulator, ReplayingAStoredEdgeReproducesItExactly) {
   }
 }
 
+// A rollout that goes on from a checkpoint of another rollout, whose command agreed with its
+// own before the checkpoint, is the full rollout bit for bit: status, end, counters and every
+// tick row. Commands changed in their last moving knot (as a correction changes a command's
+// last knots), some of them colliding or breaking a limit after the change.
+TEST(Simulator, ARolloutResumedFromACheckpointIsTheFullRollout) {
+  Scene scene("table");
+  SimulatorWorkspace ws(scene.sim);
+  const BuildSettings settings = default_settings(scene.robot);
+  int resumed = 0, invalid_after = 0;
+  for (uint64_t a = 0; a < 80; ++a) {
+    EdgeAttempt e;
+    generate_edge(scene.sim, ws, settings, a, e);
+    if (!e.valid()) continue;
+    const int knots = static_cast<int>(e.knots.size() / 7);
+    const int changed = knots - 2;  // the last moving knot changes (knot 0 and the end rest)
+    if (changed < 2) continue;
+    const double h = e.command_duration / (knots - 1);
+    const int at = ticks_before(scene.sim, (changed - 1) * h);
+    ASSERT_GT(at, 0);
+    std::vector<double> first_rows;
+    RolloutCheckpoint checkpoint;
+    simulate(scene.sim, ws, e.q0, view(e, 7), {nullptr, nullptr, 0, &first_rows},
+             {nullptr, &checkpoint, at});
+    ASSERT_EQ(checkpoint.tick, at);
+    EdgeAttempt other = e;
+    for (int k = changed; k + 1 < knots; ++k)
+      for (int i = 0; i < 7; ++i) other.knots[k * 7 + i] *= a % 3 == 0 ? 2.5 : 0.8;
+    std::vector<double> full_rows,
+        rows(first_rows.begin(), first_rows.begin() + checkpoint.tick_values);
+    const RolloutResult full =
+        simulate(scene.sim, ws, e.q0, view(other, 7), {nullptr, nullptr, 0, &full_rows});
+    const RolloutResult r = simulate(scene.sim, ws, e.q0, view(other, 7),
+                                     {nullptr, nullptr, 0, &rows}, {&checkpoint, nullptr, -1});
+    EXPECT_EQ(r.status, full.status) << "attempt " << a;
+    EXPECT_EQ(r.qf, full.qf) << "attempt " << a;
+    EXPECT_EQ(r.ticks, full.ticks);
+    EXPECT_EQ(r.collision_checks, full.collision_checks);
+    EXPECT_EQ(r.path_length, full.path_length);
+    EXPECT_EQ(rows, full_rows) << "attempt " << a;
+    ++resumed;
+    invalid_after += !full.valid();
+  }
+  EXPECT_GT(resumed, 10);
+  EXPECT_GT(invalid_after, 0);  // violations after the checkpoint are found as well
+}
+
 TEST(Simulator, ViolationsAreCaught) {
   // Into the table: a start right above it and a command driving joint 2 forward.
   Scene scene("table");

@@ -42,7 +42,8 @@ struct Work {
   SimulatorWorkspace& ws;
   const ExecutionOptions& options;
   ExecutionStats& stats;
-  std::vector<double> ticks;  // scratch: the last simulation's per-tick rows
+  std::vector<double> ticks;          // scratch: the last simulation's per-tick rows
+  RolloutCheckpoint checkpoint = {};  // scratch: where a corrected command's rollout goes on
 };
 
 bool within_limits(const RobotModel& robot, const CommandSampling& limits, int joint, double dv,
@@ -130,13 +131,24 @@ RolloutResult simulate_to_target(Work& w, const JointVectorRef& q0, std::vector<
   const int n = w.sim.robot.dof;
   if (predicted_offset.cwiseAbs().maxCoeff() > 0)
     correct_command(times, knots, first, last, -predicted_offset);
+  // A correction changes the knots from `first` on, so the command before times[first - 1] stays
+  // and every round after the first goes on from the first round's state there.
+  const int unchanged = first > 1 ? ticks_before(sim, times[first - 1]) : 0;
+  RolloutCheckpoint& from = w.checkpoint;
+  from.tick = -1;
   RolloutResult r;
   for (int round = 0;; ++round) {
-    w.ticks.clear();
+    const bool resume = round > 0 && unchanged > 0 && from.tick == unchanged;
+    if (resume)
+      w.ticks.resize(from.tick_values);
+    else
+      w.ticks.clear();
     const CommandProfile p{knots.data(), static_cast<int>(times.size()), n, times.back(),
                            uniform ? nullptr : times.data()};
-    r = simulate(sim, w.ws, q0, p, {nullptr, nullptr, 0, &w.ticks});
-    w.stats.count(r);
+    r = simulate(sim, w.ws, q0, p, {nullptr, nullptr, 0, &w.ticks},
+                 resume ? RolloutResume{&from, nullptr, -1}
+                        : RolloutResume{nullptr, &from, unchanged > 0 ? unchanged : -1});
+    w.stats.count(r, resume ? from.tick : 0);
     if (!r.valid() || round >= w.options.max_corrections) return r;
     const JointVector residual = target - r.qf;
     if (residual.cwiseAbs().maxCoeff() <= w.options.correction_tolerance) return r;

@@ -64,17 +64,22 @@ struct ExecutionStats {
   int stops = 0;        // junctions kept at rest (= junctions - blends_kept)
   int simulations =
       0;  // rollouts simulated by this stage (raw steps the planner did not hand over included)
-  long simulated_ticks = 0;  // control ticks of those rollouts
-  double seconds = 0;        // wall time of this stage (reported, never used in a decision)
+  long simulated_ticks = 0;  // control ticks of those rollouts (not those a resumed one skipped)
+  // Ticks not simulated again: a corrected command's rollout goes on from the previous round's
+  // state where the correction begins to change the command.
+  long resumed_ticks = 0;
+  double seconds = 0;  // wall time of this stage (reported, never used in a decision)
   double raw_seconds =
       0;  // of which the raw chain (re-simulating steps the planner did not hand over)
   bool fell_back = false;  // the raw chain is returned as it is
   double raw_duration = 0, raw_cost = 0;
   int raw_stops = 0;
 
-  void count(const RolloutResult& r) {
+  // A rollout that went on from a checkpoint at tick `resumed_at` simulated only the rest.
+  void count(const RolloutResult& r, int resumed_at = 0) {
     ++simulations;
-    simulated_ticks += r.ticks;
+    simulated_ticks += r.ticks - resumed_at;
+    resumed_ticks += resumed_at;
   }
 };
 

@@ -298,6 +298,9 @@ class EndEffectorTrack {
   bool can_rest() const {
     return !limits_.any() || v_.norm() / sim_.dt <= 0.5 * limits_.max_linear_acceleration;
   }
+  // The velocity of the last tick (a checkpoint's share of this tracker).
+  const Eigen::Vector3d& velocity() const { return v_; }
+  void set_velocity(const Eigen::Vector3d& v) { v_ = v; }
 
  private:
   const Simulator& sim_;
@@ -308,8 +311,62 @@ class EndEffectorTrack {
 
 }  // namespace
 
+int ticks_before(const Simulator& sim, double t) {
+  constexpr double kMargin = 1e-9;  // s: a tick at the change (up to rounding) counts as after
+  int tick = 0;
+  while (tick * sim.dt < t - kMargin) ++tick;
+  return tick;
+}
+
+namespace {
+
+// What a rollout carries from one control tick to the next (a checkpoint's content).
+struct TickState {
+  JointVector q, dq, tau_prev, ddq_prev;
+  double moved = 0;  // bound on any point's path length since the last collision check
+};
+
+void save_checkpoint(const TickState& s, const RolloutResult& result, int tick,
+                     const Eigen::Vector3d& end_effector_velocity, const TrajectorySamples& samples,
+                     RolloutCheckpoint& out) {
+  out.tick = tick;
+  out.q = s.q;
+  out.dq = s.dq;
+  out.tau_prev = s.tau_prev;
+  out.ddq_prev = s.ddq_prev;
+  out.moved = s.moved;
+  out.partial = result;
+  out.end_effector_velocity = end_effector_velocity;
+  out.tick_values = samples.ticks ? samples.ticks->size() : 0;
+}
+
+// A rollout's first tick: at rest at s.q, its start state checked (-1 and result.status when
+// it fails), or on from a checkpoint.
+int start_rollout(const Simulator& sim, SimulatorWorkspace& ws, const TrajectorySamples& samples,
+                  const RolloutCheckpoint* from, TickState& s, RolloutResult& result,
+                  EndEffectorTrack& end_effector) {
+  if (from) {
+    if (samples.q) fail("simulate", "a resumed rollout takes no float samples");
+    s = TickState{from->q, from->dq, from->tau_prev, from->ddq_prev, from->moved};
+    result = from->partial;
+    end_effector.set_velocity(from->end_effector_velocity);
+    return from->tick;
+  }
+  // At rest before the edge, the controller holds the arm against gravity.
+  s.tau_prev = gravity_torques(sim.robot, ws.robot, s.q);
+  const RolloutStatus start = check_state(sim, ws, s.q);
+  ++result.collision_checks;
+  result.status = start;
+  if (start != RolloutStatus::Valid) return -1;
+  push_sample(samples, s.q, s.dq);
+  return 0;
+}
+
+}  // namespace
+
 RolloutResult simulate(const Simulator& sim, SimulatorWorkspace& ws, const JointVectorRef& q0_in,
-                       const CommandProfile& profile, TrajectorySamples samples) {
+                       const CommandProfile& profile, TrajectorySamples samples,
+                       RolloutResume resume) {
   const RobotModel& robot = sim.robot;
   const int n = robot.dof;
   const double dt = sim.dt, h = dt / sim.options.substeps;
@@ -317,16 +374,15 @@ RolloutResult simulate(const Simulator& sim, SimulatorWorkspace& ws, const Joint
   RobotData& rd = ws.robot;
 
   RolloutResult result;
-  const JointVector q0 = q0_in;
-  JointVector q = q0, dq = JointVector::Zero(n), q_prev = q0;
-  JointVector v_cmd(n), a_cmd(n), offset(n), tau(n);
-  // At rest before the edge, the controller holds the arm against gravity.
-  JointVector tau_prev = gravity_torques(robot, rd, q0);
-  JointVector ddq_prev = JointVector::Zero(n);
+  TickState s{q0_in, JointVector::Zero(n), {}, JointVector::Zero(n), 0};
+  JointVector& q = s.q;
+  JointVector& dq = s.dq;
+  JointVector q_prev = q, v_cmd(n), a_cmd(n), offset(n), tau(n);
   Stages k(n);
   JointVector ddq(n);
   const JointVector tau_rate_max = robot.dtau_max * dt;
   const JointVector ddq_step_max = robot.dddq_max * dt;
+  EndEffectorTrack end_effector(sim, rd);
 
   auto finish = [&](RolloutStatus status, int tick) {
     result.status = status;
@@ -336,16 +392,14 @@ RolloutResult simulate(const Simulator& sim, SimulatorWorkspace& ws, const Joint
     return result;
   };
 
-  RolloutStatus start = check_state(sim, ws, q0);
-  ++result.collision_checks;
-  if (start != RolloutStatus::Valid) return finish(start, 0);
-  push_sample(samples, q, dq);
-  EndEffectorTrack end_effector(sim, rd);
+  const int first_tick = start_rollout(sim, ws, samples, resume.from, s, result, end_effector);
+  if (first_tick < 0) return finish(result.status, 0);
 
   const int max_ticks =
       static_cast<int>(std::ceil((profile.duration + sim.options.max_settle_time) / dt));
-  double moved = 0;  // bound on any point's path length since the last collision check
-  for (int tick = 0; tick < max_ticks; ++tick) {
+  for (int tick = first_tick; tick < max_ticks; ++tick) {
+    if (tick == resume.save_at && resume.save)
+      save_checkpoint(s, result, tick, end_effector.velocity(), samples, *resume.save);
     const double t = tick * dt;
     evaluate_command(profile, t, v_cmd.data(), a_cmd.data(), offset.data());
 
@@ -354,35 +408,38 @@ RolloutResult simulate(const Simulator& sim, SimulatorWorkspace& ws, const Joint
     dynamics_terms(robot, rd, q, dq);
     controller_torque(robot, rd, v_cmd, a_cmd, dq, tau);
     if (!within(tau, robot.tau_max)) return finish(RolloutStatus::TorqueLimit, tick);
-    if (!within(tau - tau_prev, tau_rate_max)) return finish(RolloutStatus::TorqueRateLimit, tick);
-    tau_prev = tau;
+    if (!within(tau - s.tau_prev, tau_rate_max))
+      return finish(RolloutStatus::TorqueRateLimit, tick);
+    s.tau_prev = tau;
 
     // Stop once at rest after the command (the last motion collision-checked).
-    if (t >= profile.duration && at_rest(sim, rd, dq, ddq_prev, tau, ddq_step_max, tau_rate_max) &&
+    if (t >= profile.duration &&
+        at_rest(sim, rd, dq, s.ddq_prev, tau, ddq_step_max, tau_rate_max) &&
         end_effector.can_rest()) {
-      if (moved > 0) {
+      if (s.moved > 0) {
         const RolloutStatus c = collision_status(sim, ws, q, result.collision_checks);
         if (c != RolloutStatus::Valid) return finish(c, tick);
       }
       if (samples.q && (sample_every <= 0 || tick % sample_every != 0)) push_sample(samples, q, dq);
-      if (samples.ticks) push_tick(*samples.ticks, q, dq, ddq_prev, v_cmd);
+      if (samples.ticks) push_tick(*samples.ticks, q, dq, s.ddq_prev, v_cmd);
       return finish(RolloutStatus::Valid, tick);
     }
 
-    if (samples.ticks) push_tick(*samples.ticks, q, dq, ddq_prev, v_cmd);
+    if (samples.ticks) push_tick(*samples.ticks, q, dq, s.ddq_prev, v_cmd);
     q_prev = q;
     integrate_period(sim, rd, tau, h, q, dq, ddq, k);
     if (samples.ticks) std::copy(ddq.data(), ddq.data() + n, samples.ticks->end() - 2 * n);
     if (!within(ddq, robot.ddq_max)) return finish(RolloutStatus::AccelerationLimit, tick);
-    if (!within(ddq - ddq_prev, ddq_step_max)) return finish(RolloutStatus::JerkLimit, tick);
-    ddq_prev = ddq;
+    if (!within(ddq - s.ddq_prev, ddq_step_max)) return finish(RolloutStatus::JerkLimit, tick);
+    s.ddq_prev = ddq;
     const RolloutStatus limits = state_limits(robot, q, dq);
     if (limits != RolloutStatus::Valid) return finish(limits, tick + 1);
     const RolloutStatus task = end_effector.step(q, dq, tick == 0);
     if (task != RolloutStatus::Valid) return finish(task, tick + 1);
 
     result.path_length += (q - q_prev).norm();
-    const RolloutStatus c = check_motion(sim, ws, q_prev, q, moved, k.k1q, result.collision_checks);
+    const RolloutStatus c =
+        check_motion(sim, ws, q_prev, q, s.moved, k.k1q, result.collision_checks);
     if (c != RolloutStatus::Valid) return finish(c, tick);
     if (sample_every > 0 && (tick + 1) % sample_every == 0) push_sample(samples, q, dq);
   }

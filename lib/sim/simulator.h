@@ -115,10 +115,36 @@ struct TrajectorySamples {
   std::vector<double>* ticks = nullptr;
 };
 
-// Simulates from rest at q0. Stops at the first violation. Allocates nothing when the sample
-// vectors have capacity.
+// A rollout's state at the start of a control tick: enough to go on from there exactly as the
+// rollout it was saved from (bit for bit), for a command that agrees with that rollout's
+// command at every earlier tick (issue 27: a corrected command re-simulates only what changed).
+struct RolloutCheckpoint {
+  int tick = -1;  // -1: none saved
+  JointVector q, dq, tau_prev, ddq_prev;
+  double moved = 0;       // the collision-check spacing's path since the last check
+  RolloutResult partial;  // collision checks and path length so far
+  Eigen::Vector3d end_effector_velocity = Eigen::Vector3d::Zero();
+  size_t tick_values = 0;  // TrajectorySamples::ticks values up to that tick
+};
+
+// Optional: `save` gets the state at the start of tick `save_at` when the rollout gets there
+// (untouched otherwise); `from` continues a saved rollout: the caller's samples.ticks must hold
+// its rows up to the checkpoint (from->tick_values values), and no float samples are taken.
+struct RolloutResume {
+  const RolloutCheckpoint* from = nullptr;
+  RolloutCheckpoint* save = nullptr;
+  int save_at = -1;
+};
+
+// The first tick whose command time (tick * dt, as simulate computes it) is not before t by a
+// margin: a command changed from time t on leaves every earlier tick as it was.
+int ticks_before(const Simulator& sim, double t);
+
+// Simulates from rest at q0 (or on from resume.from). Stops at the first violation. Allocates
+// nothing when the sample vectors have capacity.
 RolloutResult simulate(const Simulator& sim, SimulatorWorkspace& ws, const JointVectorRef& q0,
-                       const CommandProfile& profile, TrajectorySamples samples = {});
+                       const CommandProfile& profile, TrajectorySamples samples = {},
+                       RolloutResume resume = {});
 
 // Limits and collision of a single configuration at rest (for start states and queries).
 RolloutStatus check_state(const Simulator& sim, SimulatorWorkspace& ws, const JointVectorRef& q);
