@@ -163,8 +163,8 @@ TEST(Execution, BlendedTrajectoryPassesReSimulationAndReValidation) {
   EXPECT_EQ(s.stops, s.junctions - s.blends_kept);
   EXPECT_EQ(e.trajectory.stops, s.stops);
   EXPECT_LT(e.trajectory.duration, s.raw_duration);
-  // Corrections of joined commands went on from where they changed the command; the segments
-  // are still what a fresh simulation of their commands gives, tick for tick.
+  // Rollouts went on from earlier ones where their commands agreed (corrections of joined
+  // commands); the segments are still what a fresh simulation of their commands gives.
   EXPECT_GT(s.resumed_ticks, 0);
   EXPECT_EQ(resimulate_segments(f.sim, e, c.problem.start), "");
   EXPECT_EQ(validate(f, e.trajectory, c.problem.start, c.problem.goal.q, kTolerance, "boe"), "");

@@ -15,6 +15,19 @@ constexpr double kPeakCurvature = 5.773502691896258;
 // Fraction of the command limits a direct command between two steps uses.
 constexpr double kJunctionRoom = 0.7;
 
+// A rollout of this stage, kept with checkpoints at its knots, so that a later command from
+// the same start that agrees with it up to some knot goes on from there rather than being
+// simulated again (issue 27): a correction round, a junction tried again or split into a stop,
+// a segment that begins with a shortcut's simulated command.
+struct Trail {
+  JointVector q0;  // its start (empty: no rollout)
+  std::vector<double> times, knots;
+  bool uniform = false;
+  std::vector<int> knot_ticks;                 // ticks_before(times[k]), k >= 1
+  std::vector<RolloutCheckpoint> checkpoints;  // at those ticks the rollout got to
+  std::vector<double> rows;                    // its per-tick rows
+};
+
 // A step of the path being processed: its command with knot times, and the raw chain's state
 // it should end at.
 struct Step {
@@ -23,10 +36,11 @@ struct Step {
   int first_raw = 0, last_raw = 0;  // the raw steps it stands for
   bool uniform = false;             // evenly spaced knots (a raw step's)
   // A shortcut's accepted simulation from the raw chain's state (the blend pass reuses it for a
-  // segment of this step alone from that same state).
+  // segment of this step alone from that same state, and goes on from its checkpoints for a
+  // segment that begins with it).
   bool simulated = false;
   RolloutResult result;
-  std::vector<double> ticks;
+  Trail trail;
 };
 
 // The raw chain: the planner's path, each step from the previous end, as realize_path has it.
@@ -42,8 +56,8 @@ struct Work {
   SimulatorWorkspace& ws;
   const ExecutionOptions& options;
   ExecutionStats& stats;
-  std::vector<double> ticks;          // scratch: the last simulation's per-tick rows
-  RolloutCheckpoint checkpoint = {};  // scratch: where a corrected command's rollout goes on
+  Trail trail = {};  // the last rollout (its rows: the last simulation's per-tick rows)
+  Trail spare = {};  // scratch for the next one
 };
 
 bool within_limits(const RobotModel& robot, const CommandSampling& limits, int joint, double dv,
@@ -100,7 +114,7 @@ std::vector<Step> raw_steps(const std::vector<PathStep>& steps, const RawChain& 
     if (k + 1 == steps.size() && steps[k].outcome && !steps[k].outcome_rows.empty()) {
       out[k].simulated = true;
       out[k].result = *steps[k].outcome;
-      out[k].ticks = steps[k].outcome_rows;
+      out[k].trail.rows = steps[k].outcome_rows;  // no checkpoints: never gone on from
     }
   }
   return out;
@@ -118,37 +132,79 @@ void correct_command(std::vector<double>& times, std::vector<double>& knots, int
     for (int i = 0; i < n; ++i) knots[j * n + i] += delta[i] / weight;
 }
 
-// Simulates a command from rest at q0 into w.ticks; corrects its end offset from `target`
+// The latest checkpoint of `t` a command from q0 can go on from: commands that agree in their
+// first d knots (times and values) agree at every tick before times[d - 1] (the command there
+// depends on knots d - 2 and d - 1 only). Evenly spaced knots agree only with the same times.
+const RolloutCheckpoint* resume_point(const Trail& t, const JointVectorRef& q0,
+                                      const std::vector<double>& times,
+                                      const std::vector<double>& knots, bool uniform, int n) {
+  if (t.checkpoints.empty() || t.uniform != uniform || t.q0.size() != q0.size() || t.q0 != q0 ||
+      (uniform && t.times != times))
+    return nullptr;
+  size_t d = 0;
+  while (d < times.size() && d < t.times.size() && times[d] == t.times[d] &&
+         std::equal(knots.begin() + d * n, knots.begin() + (d + 1) * n, t.knots.begin() + d * n))
+    ++d;
+  if (d < 2) return nullptr;
+  const int before = t.knot_ticks[d - 2];  // ticks_before(times[d - 1])
+  const RolloutCheckpoint* best = nullptr;
+  for (const RolloutCheckpoint& c : t.checkpoints)
+    if (c.tick <= before) best = &c;
+  return best;
+}
+
+// Simulates a command from rest at q0, going on from the latest checkpoint of the last rollout
+// or of `also` that it agrees with; it becomes the last rollout (w.trail, its rows included).
+RolloutResult rollout(Work& w, const Simulator& sim, const JointVectorRef& q0,
+                      const std::vector<double>& times, const std::vector<double>& knots,
+                      bool uniform, const Trail* also) {
+  const int n = sim.robot.dof;
+  const Trail* source = &w.trail;
+  const RolloutCheckpoint* from = resume_point(w.trail, q0, times, knots, uniform, n);
+  const RolloutCheckpoint* other =
+      also ? resume_point(*also, q0, times, knots, uniform, n) : nullptr;
+  if (other && (!from || other->tick > from->tick)) {
+    source = also;
+    from = other;
+  }
+  Trail& next = w.spare;
+  next.q0 = q0;
+  next.times = times;
+  next.knots = knots;
+  next.uniform = uniform;
+  next.knot_ticks.clear();
+  for (size_t k = 1; k < times.size(); ++k) next.knot_ticks.push_back(ticks_before(sim, times[k]));
+  next.checkpoints.clear();
+  next.rows.clear();
+  if (from) {  // the shared part: its rows and the checkpoints before the one gone on from
+    for (const RolloutCheckpoint& c : source->checkpoints)
+      if (c.tick < from->tick) next.checkpoints.push_back(c);
+    next.rows.assign(source->rows.begin(), source->rows.begin() + from->tick_values);
+  }
+  const CommandProfile p{knots.data(), static_cast<int>(times.size()), n, times.back(),
+                         uniform ? nullptr : times.data()};
+  const RolloutResult r = simulate(sim, w.ws, q0, p, {nullptr, nullptr, 0, &next.rows},
+                                   {from, &next.knot_ticks, &next.checkpoints});
+  w.stats.count(r, from ? from->tick : 0);
+  std::swap(w.trail, w.spare);
+  return r;
+}
+
+// Simulates a command from rest at q0 (a rollout); corrects its end offset from `target`
 // (knots [first, last) carry the correction) up to max_corrections times. `offset` is the
 // predicted end offset before any simulation (the start's offset from the raw chain).
 // `uniform`: the knots are evenly spaced, simulated as such (a raw step alone is then its own
-// bundle command, bit for bit).
+// bundle command, bit for bit). A correction round goes on from where it changes the command.
 RolloutResult simulate_to_target(Work& w, const JointVectorRef& q0, std::vector<double>& times,
                                  std::vector<double>& knots, int first, int last,
                                  const JointVector& target, const JointVector& predicted_offset,
-                                 bool ends_trajectory, bool uniform = false) {
+                                 bool ends_trajectory, bool uniform = false,
+                                 const Trail* also = nullptr) {
   const Simulator& sim = ends_trajectory ? w.final_sim : w.sim;
-  const int n = w.sim.robot.dof;
   if (predicted_offset.cwiseAbs().maxCoeff() > 0)
     correct_command(times, knots, first, last, -predicted_offset);
-  // A correction changes the knots from `first` on, so the command before times[first - 1] stays
-  // and every round after the first goes on from the first round's state there.
-  const int unchanged = first > 1 ? ticks_before(sim, times[first - 1]) : 0;
-  RolloutCheckpoint& from = w.checkpoint;
-  from.tick = -1;
-  RolloutResult r;
   for (int round = 0;; ++round) {
-    const bool resume = round > 0 && unchanged > 0 && from.tick == unchanged;
-    if (resume)
-      w.ticks.resize(from.tick_values);
-    else
-      w.ticks.clear();
-    const CommandProfile p{knots.data(), static_cast<int>(times.size()), n, times.back(),
-                           uniform ? nullptr : times.data()};
-    r = simulate(sim, w.ws, q0, p, {nullptr, nullptr, 0, &w.ticks},
-                 resume ? RolloutResume{&from, nullptr, -1}
-                        : RolloutResume{nullptr, &from, unchanged > 0 ? unchanged : -1});
-    w.stats.count(r, resume ? from.tick : 0);
+    const RolloutResult r = rollout(w, sim, q0, times, knots, uniform, also);
     if (!r.valid() || round >= w.options.max_corrections) return r;
     const JointVector residual = target - r.qf;
     if (residual.cwiseAbs().maxCoeff() <= w.options.correction_tolerance) return r;
@@ -262,7 +318,7 @@ std::vector<Step> shortcut_steps(Work& w, const RawChain& raw, std::vector<Step>
       continue;
     }
     direct.simulated = true;
-    direct.ticks = w.ticks;  // of the accepted simulation, the last one made
+    direct.trail = w.trail;  // of the accepted simulation, the last one made
     direct.target = raw.states[accepted + 1];
     direct.first_raw = i;
     direct.last_raw = accepted;
@@ -350,11 +406,11 @@ Attempt try_segment(Work& w, const std::vector<Step>& steps, const RawChain& raw
   RolloutResult r;
   if (a == b && steps[a].simulated && offset.cwiseAbs().maxCoeff() == 0) {
     r = steps[a].result;  // this very command from this very state (and settle): simulated
-    w.ticks = steps[a].ticks;
+    w.trail = steps[a].trail;
   } else {
     r = simulate_to_target(w, q0, j.times, j.knots, j.last_step_first_knot,
                            static_cast<int>(j.times.size()) - 1, steps[b].target, offset, last,
-                           uniform);
+                           uniform, &steps[a].trail);
   }
   const bool lands = r.valid() && (r.qf - steps[b].target).norm() <= w.options.end_tolerance &&
                      (!last || goal.contains(w.sim.robot, w.ws.robot, r.qf));
@@ -429,8 +485,8 @@ bool blend_segments(Work& w, const std::vector<Step>& steps, const RawChain& raw
       }
       b = a + at.junction;  // the junction after step b keeps its stop
     }
-    tick_rows.insert(tick_rows.end(), w.ticks.begin(), w.ticks.end());
-    segment_rows.push_back(w.ticks.size());
+    tick_rows.insert(tick_rows.end(), w.trail.rows.begin(), w.trail.rows.end());
+    segment_rows.push_back(w.trail.rows.size());
     q0 = seg.result.qf;
     segments.push_back(std::move(seg));
     a = b + 1;

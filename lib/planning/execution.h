@@ -65,8 +65,9 @@ struct ExecutionStats {
   int simulations =
       0;  // rollouts simulated by this stage (raw steps the planner did not hand over included)
   long simulated_ticks = 0;  // control ticks of those rollouts (not those a resumed one skipped)
-  // Ticks not simulated again: a corrected command's rollout goes on from the previous round's
-  // state where the correction begins to change the command.
+  // Ticks not simulated again: a rollout whose command agrees with an earlier one's from the
+  // same start up to a knot (a correction round, a junction tried again or split into a stop,
+  // a segment that begins with a shortcut) goes on from that one's state there.
   long resumed_ticks = 0;
   double seconds = 0;  // wall time of this stage (reported, never used in a decision)
   double raw_seconds =

@@ -326,19 +326,35 @@ struct TickState {
   double moved = 0;  // bound on any point's path length since the last collision check
 };
 
-void save_checkpoint(const TickState& s, const RolloutResult& result, int tick,
-                     const Eigen::Vector3d& end_effector_velocity, const TrajectorySamples& samples,
-                     RolloutCheckpoint& out) {
-  out.tick = tick;
-  out.q = s.q;
-  out.dq = s.dq;
-  out.tau_prev = s.tau_prev;
-  out.ddq_prev = s.ddq_prev;
-  out.moved = s.moved;
-  out.partial = result;
-  out.end_effector_velocity = end_effector_velocity;
-  out.tick_values = samples.ticks ? samples.ticks->size() : 0;
-}
+// The checkpoints a rollout saves (RolloutResume::save_at, into RolloutResume::saved).
+class CheckpointSaver {
+ public:
+  CheckpointSaver(const RolloutResume& resume, int first_tick)
+      : at_(resume.saved ? resume.save_at : nullptr), saved_(resume.saved) {
+    while (at_ && next_ < at_->size() && (*at_)[next_] < first_tick) ++next_;
+  }
+  bool due(int tick) const { return at_ && next_ < at_->size() && (*at_)[next_] == tick; }
+  void save(const TickState& s, const RolloutResult& result, int tick,
+            const Eigen::Vector3d& end_effector_velocity, const TrajectorySamples& samples) {
+    while (due(tick)) ++next_;  // one checkpoint for repeated ticks
+    saved_->emplace_back();
+    RolloutCheckpoint& out = saved_->back();
+    out.tick = tick;
+    out.q = s.q;
+    out.dq = s.dq;
+    out.tau_prev = s.tau_prev;
+    out.ddq_prev = s.ddq_prev;
+    out.moved = s.moved;
+    out.partial = result;
+    out.end_effector_velocity = end_effector_velocity;
+    out.tick_values = samples.ticks ? samples.ticks->size() : 0;
+  }
+
+ private:
+  const std::vector<int>* at_;
+  std::vector<RolloutCheckpoint>* saved_;
+  size_t next_ = 0;
+};
 
 // A rollout's first tick: at rest at s.q, its start state checked (-1 and result.status when
 // it fails), or on from a checkpoint.
@@ -397,9 +413,9 @@ RolloutResult simulate(const Simulator& sim, SimulatorWorkspace& ws, const Joint
 
   const int max_ticks =
       static_cast<int>(std::ceil((profile.duration + sim.options.max_settle_time) / dt));
+  CheckpointSaver saver(resume, first_tick);
   for (int tick = first_tick; tick < max_ticks; ++tick) {
-    if (tick == resume.save_at && resume.save)
-      save_checkpoint(s, result, tick, end_effector.velocity(), samples, *resume.save);
+    if (saver.due(tick)) saver.save(s, result, tick, end_effector.velocity(), samples);
     const double t = tick * dt;
     evaluate_command(profile, t, v_cmd.data(), a_cmd.data(), offset.data());
 

@@ -127,13 +127,13 @@ struct RolloutCheckpoint {
   size_t tick_values = 0;  // TrajectorySamples::ticks values up to that tick
 };
 
-// Optional: `save` gets the state at the start of tick `save_at` when the rollout gets there
-// (untouched otherwise); `from` continues a saved rollout: the caller's samples.ticks must hold
-// its rows up to the checkpoint (from->tick_values values), and no float samples are taken.
+// Optional: `from` continues a saved rollout (the caller's samples.ticks must hold its rows up
+// to the checkpoint, from->tick_values values, and no float samples are taken); `saved` gets
+// the state at the start of each tick of `save_at` (increasing) that the rollout gets to.
 struct RolloutResume {
   const RolloutCheckpoint* from = nullptr;
-  RolloutCheckpoint* save = nullptr;
-  int save_at = -1;
+  const std::vector<int>* save_at = nullptr;
+  std::vector<RolloutCheckpoint>* saved = nullptr;
 };
 
 // The first tick whose command time (tick * dt, as simulate computes it) is not before t by a
