@@ -7,7 +7,8 @@
 // with any thread count (test_query_cli); commands with knot times evaluate as evenly spaced ones
 // do. The planners hand over their simulation of each step, so the raw chain is not simulated
 // again; the bundle planners answer a free straight command with it (found_by direct), a blocked
-// one by searching.
+// one by searching. Rollouts that go on from earlier ones' checkpoints change nothing but the
+// ticks simulated.
 #include <gtest/gtest.h>
 
 #include <memory>
@@ -327,6 +328,42 @@ TEST(Execution, BlendThatWouldCollideKeepsItsStop) {
   EXPECT_EQ(checker_verdict(*o.sim, e.trajectory),
             "");  // the kept stop too: at rest within every rate limit
   expect_at_rest_ends(*o.sim, e, c.problem);
+}
+
+// Rollouts that go on from earlier ones where their commands agree (corrections, a junction
+// tried again or split into a stop) give the trajectories and decisions that simulating every
+// rollout from its start gives; only the ticks simulated differ, by the ticks gone on from.
+TEST(Execution, GoingOnFromEarlierRolloutsChangesNothing) {
+  const Fixture& f = fixture();
+  const PathCase& c = long_path();
+  ASSERT_TRUE(c.result.success) << c.result.failure;
+  ExecutionOptions one_blend = options(false, true);
+  one_blend.blend_scales = {0.5};
+  Obstructed o;
+  ASSERT_TRUE(place_obstacle(f, c, execute(f.sim, c, one_blend), 0, o));
+  struct Case {
+    const Simulator* sim;
+    ExecutionOptions options;
+  };
+  const std::vector<Case> cases = {
+      {&f.sim, options(false, true)}, {&f.sim, options(true, true)}, {o.sim.get(), one_blend}};
+  long resumed = 0;
+  for (size_t k = 0; k < cases.size(); ++k) {
+    SCOPED_TRACE("case " + std::to_string(k));
+    ExecutionOptions fresh = cases[k].options;
+    fresh.resume = false;
+    const ExecutableTrajectory a = execute(*cases[k].sim, c, cases[k].options);
+    const ExecutableTrajectory b = execute(*cases[k].sim, c, fresh);
+    EXPECT_TRUE(a.trajectory.q == b.trajectory.q && a.trajectory.dq == b.trajectory.dq &&
+                a.trajectory.ddq == b.trajectory.ddq && a.trajectory.cmd == b.trajectory.cmd);
+    EXPECT_EQ(a.segments.size(), b.segments.size());
+    EXPECT_EQ(a.stats.simulations, b.stats.simulations);
+    EXPECT_EQ(a.stats.stops, b.stats.stops);
+    EXPECT_EQ(b.stats.resumed_ticks, 0);
+    EXPECT_EQ(a.stats.simulated_ticks + a.stats.resumed_ticks, b.stats.simulated_ticks);
+    resumed += a.stats.resumed_ticks;
+  }
+  EXPECT_GT(resumed, 0);
 }
 
 // The planners hand over their simulation of every step: the post-processing does not simulate

@@ -159,10 +159,12 @@ RolloutResult rollout(Work& w, const Simulator& sim, const JointVectorRef& q0,
                       const std::vector<double>& times, const std::vector<double>& knots,
                       bool uniform, const Trail* also) {
   const int n = sim.robot.dof;
+  const bool resume = w.options.resume;
   const Trail* source = &w.trail;
-  const RolloutCheckpoint* from = resume_point(w.trail, q0, times, knots, uniform, n);
+  const RolloutCheckpoint* from =
+      resume ? resume_point(w.trail, q0, times, knots, uniform, n) : nullptr;
   const RolloutCheckpoint* other =
-      also ? resume_point(*also, q0, times, knots, uniform, n) : nullptr;
+      resume && also ? resume_point(*also, q0, times, knots, uniform, n) : nullptr;
   if (other && (!from || other->tick > from->tick)) {
     source = also;
     from = other;

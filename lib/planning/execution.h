@@ -35,7 +35,10 @@ struct ExecutionOptions {
   int max_corrections = 2;             // re-simulations to correct a segment's end offset
   double correction_tolerance = 2e-3;  // rad (max norm): no correction below this end offset
   double end_tolerance = 0.01;         // rad: a segment may end this far from the raw chain
-  CommandSampling limits;              // speed and limit fractions of the commands built here
+  // A rollout goes on from an earlier one's checkpoint where their commands agree (false: every
+  // rollout from its start; the same trajectories, for comparing).
+  bool resume = true;
+  CommandSampling limits;  // speed and limit fractions of the commands built here
   // Shortened junction intervals, as fractions of the original two: the first within the
   // commanded limits is simulated; a failure is tried once more with the last, then stops.
   std::vector<double> blend_scales = {0.5, 0.6, 0.7, 0.8, 0.9};
