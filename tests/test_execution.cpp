@@ -356,7 +356,14 @@ TEST(Execution, GoingOnFromEarlierRolloutsChangesNothing) {
     const ExecutableTrajectory b = execute(*cases[k].sim, c, fresh);
     EXPECT_TRUE(a.trajectory.q == b.trajectory.q && a.trajectory.dq == b.trajectory.dq &&
                 a.trajectory.ddq == b.trajectory.ddq && a.trajectory.cmd == b.trajectory.cmd);
-    EXPECT_EQ(a.segments.size(), b.segments.size());
+    EXPECT_EQ(a.trajectory.cost, b.trajectory.cost);
+    ASSERT_EQ(a.segments.size(), b.segments.size());
+    for (size_t s = 0; s < a.segments.size(); ++s) {
+      const RolloutResult &x = a.segments[s].result, &y = b.segments[s].result;
+      EXPECT_TRUE(x.status == y.status && x.qf == y.qf && x.ticks == y.ticks &&
+                  x.collision_checks == y.collision_checks && x.path_length == y.path_length)
+          << "segment " << s;
+    }
     EXPECT_EQ(a.stats.simulations, b.stats.simulations);
     EXPECT_EQ(a.stats.stops, b.stats.stops);
     EXPECT_EQ(b.stats.resumed_ticks, 0);

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <cmath>
 #include <cstdlib>
 #include <new>
 
@@ -204,53 +205,77 @@ TEST(Simulator, ReplayingAStoredEdgeReproducesItExactly) {
   }
 }
 
+// Resumes `other` from the checkpoint of `e`'s rollout at tick `at` and compares it with
+// `other` simulated from the start: status, end, counters and every tick row. Counts the
+// comparisons made and those whose full rollout is invalid.
+void expect_resumed_is_full(const Simulator& sim, SimulatorWorkspace& ws, const JointVector& q0,
+                            const CommandProfile& first, const CommandProfile& other, int at,
+                            int& resumed, int& invalid_after) {
+  std::vector<double> first_rows;
+  const std::vector<int> save_at = {at / 2, at, at};  // a repeated tick is saved once
+  std::vector<RolloutCheckpoint> saved;
+  const RolloutResult r0 =
+      simulate(sim, ws, q0, first, {nullptr, nullptr, 0, &first_rows}, {nullptr, &save_at, &saved});
+  if (r0.ticks < at) return;  // it ended before: nothing to go on from
+  ASSERT_EQ(saved.size(), 2u);
+  ASSERT_EQ(saved[1].tick, at);
+  const RolloutCheckpoint& checkpoint = saved[1];
+  std::vector<double> full_rows,
+      rows(first_rows.begin(), first_rows.begin() + checkpoint.tick_values);
+  const RolloutResult full = simulate(sim, ws, q0, other, {nullptr, nullptr, 0, &full_rows});
+  const RolloutResult r = simulate(sim, ws, q0, other, {nullptr, nullptr, 0, &rows}, {&checkpoint});
+  EXPECT_EQ(r.status, full.status);
+  EXPECT_EQ(r.qf, full.qf);
+  EXPECT_EQ(r.ticks, full.ticks);
+  EXPECT_EQ(r.collision_checks, full.collision_checks);
+  EXPECT_EQ(r.path_length, full.path_length);
+  EXPECT_EQ(rows, full_rows);
+  ++resumed;
+  invalid_after += !full.valid();
+}
+
 // A rollout that goes on from a checkpoint of another rollout, whose command agreed with its
-// own before the checkpoint, is the full rollout bit for bit: status, end, counters and every
-// tick row. Commands changed in their last moving knot (as a correction changes a command's
-// last knots), some of them colliding or breaking a limit after the change.
+// own before the checkpoint, is the full rollout bit for bit. Commands changed in their last
+// moving knot (as a correction changes a command's last knots), some of them colliding or
+// breaking a limit after the change; evenly spaced knots in the table scene, and uneven knot
+// times with end-effector speed and acceleration limits (the tracker's state is carried too).
 TEST(Simulator, ARolloutResumedFromACheckpointIsTheFullRollout) {
   Scene scene("table");
+  EndEffectorLimits hand;
+  hand.link = scene.robot.tip_link();
+  hand.max_linear_speed = 0.6;          // m/s: some changed commands break it
+  hand.max_linear_acceleration = 15.0;  // m/s^2
+  const Simulator limited(scene.robot, scene.collision, scene.sim.options, hand);
   SimulatorWorkspace ws(scene.sim);
   const BuildSettings settings = default_settings(scene.robot);
-  int resumed = 0, invalid_after = 0;
+  int resumed[2] = {0, 0}, invalid_after[2] = {0, 0};
   for (uint64_t a = 0; a < 80; ++a) {
+    SCOPED_TRACE("attempt " + std::to_string(a));
     EdgeAttempt e;
     generate_edge(scene.sim, ws, settings, a, e);
     if (!e.valid()) continue;
     const int knots = static_cast<int>(e.knots.size() / 7);
     const int changed = knots - 2;  // the last moving knot changes (knot 0 and the end rest)
     if (changed < 2) continue;
-    const double h = e.command_duration / (knots - 1);
-    const int at = ticks_before(scene.sim, (changed - 1) * h);
-    ASSERT_GT(at, 0);
-    std::vector<double> first_rows;
-    const std::vector<int> save_at = {at / 2, at, at};  // a repeated tick is saved once
-    std::vector<RolloutCheckpoint> saved;
-    simulate(scene.sim, ws, e.q0, view(e, 7), {nullptr, nullptr, 0, &first_rows},
-             {nullptr, &save_at, &saved});
-    ASSERT_EQ(saved.size(), 2u);
-    ASSERT_EQ(saved[1].tick, at);
-    const RolloutCheckpoint& checkpoint = saved[1];
     EdgeAttempt other = e;
     for (int k = changed; k + 1 < knots; ++k)
       for (int i = 0; i < 7; ++i) other.knots[k * 7 + i] *= a % 3 == 0 ? 2.5 : 0.8;
-    std::vector<double> full_rows,
-        rows(first_rows.begin(), first_rows.begin() + checkpoint.tick_values);
-    const RolloutResult full =
-        simulate(scene.sim, ws, e.q0, view(other, 7), {nullptr, nullptr, 0, &full_rows});
-    const RolloutResult r =
-        simulate(scene.sim, ws, e.q0, view(other, 7), {nullptr, nullptr, 0, &rows}, {&checkpoint});
-    EXPECT_EQ(r.status, full.status) << "attempt " << a;
-    EXPECT_EQ(r.qf, full.qf) << "attempt " << a;
-    EXPECT_EQ(r.ticks, full.ticks);
-    EXPECT_EQ(r.collision_checks, full.collision_checks);
-    EXPECT_EQ(r.path_length, full.path_length);
-    EXPECT_EQ(rows, full_rows) << "attempt " << a;
-    ++resumed;
-    invalid_after += !full.valid();
+    const double h = e.command_duration / (knots - 1);
+    expect_resumed_is_full(scene.sim, ws, e.q0, view(e, 7), view(other, 7),
+                           ticks_before(scene.sim, (changed - 1) * h), resumed[0],
+                           invalid_after[0]);
+    std::vector<double> times(knots);  // uneven: interior knots moved by up to 0.3 h
+    for (int k = 0; k < knots; ++k)
+      times[k] = k == 0 || k + 1 == knots ? k * h : (k + 0.3 * std::sin(3.0 * k + a)) * h;
+    CommandProfile timed = view(e, 7), timed_other = view(other, 7);
+    timed.times = timed_other.times = times.data();
+    expect_resumed_is_full(limited, ws, e.q0, timed, timed_other,
+                           ticks_before(limited, times[changed - 1]), resumed[1], invalid_after[1]);
   }
-  EXPECT_GT(resumed, 10);
-  EXPECT_GT(invalid_after, 0);  // violations after the checkpoint are found as well
+  for (int v = 0; v < 2; ++v) {
+    EXPECT_GT(resumed[v], 10) << "variant " << v;
+    EXPECT_GT(invalid_after[v], 0) << "variant " << v;  // violations after it are found too
+  }
 }
 
 TEST(Simulator, ViolationsAreCaught) {

@@ -270,6 +270,7 @@ nlohmann::json execution_json(const ExecutionStats& e) {
           {"blends_kept", e.blends_kept},
           {"simulations", e.simulations},
           {"simulated_ticks", e.simulated_ticks},
+          {"resumed_ticks", e.resumed_ticks},
           {"seconds", e.seconds},
           {"raw_seconds", e.raw_seconds},
           {"fell_back", e.fell_back}};

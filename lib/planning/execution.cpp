@@ -17,9 +17,11 @@ constexpr double kJunctionRoom = 0.7;
 
 // A rollout of this stage, kept with checkpoints at its knots, so that a later command from
 // the same start that agrees with it up to some knot goes on from there rather than being
-// simulated again (issue 27): a correction round, a junction tried again or split into a stop,
-// a segment that begins with a shortcut's simulated command.
+// simulated again (issue 27): a correction round of a joined command (one of a single step
+// changes it from its first knot on: simulated again), a junction tried again or split into a
+// stop, a segment that begins with a shortcut's simulated command.
 struct Trail {
+  const Simulator* sim = nullptr;
   JointVector q0;  // its start (empty: no rollout)
   std::vector<double> times, knots;
   bool uniform = false;
@@ -56,7 +58,7 @@ struct Work {
   SimulatorWorkspace& ws;
   const ExecutionOptions& options;
   ExecutionStats& stats;
-  Trail trail = {};  // the last rollout (its rows: the last simulation's per-tick rows)
+  Trail trail = {};  // the last rollout made or reused (its rows: the segment's per-tick rows)
   Trail spare = {};  // scratch for the next one
 };
 
@@ -135,11 +137,12 @@ void correct_command(std::vector<double>& times, std::vector<double>& knots, int
 // The latest checkpoint of `t` a command from q0 can go on from: commands that agree in their
 // first d knots (times and values) agree at every tick before times[d - 1] (the command there
 // depends on knots d - 2 and d - 1 only). Evenly spaced knots agree only with the same times.
-const RolloutCheckpoint* resume_point(const Trail& t, const JointVectorRef& q0,
-                                      const std::vector<double>& times,
-                                      const std::vector<double>& knots, bool uniform, int n) {
-  if (t.checkpoints.empty() || t.uniform != uniform || t.q0.size() != q0.size() || t.q0 != q0 ||
-      (uniform && t.times != times))
+const RolloutCheckpoint* resume_point(const Trail& t, const Simulator& sim,
+                                      const JointVectorRef& q0, const std::vector<double>& times,
+                                      const std::vector<double>& knots, bool uniform) {
+  const int n = sim.robot.dof;
+  if (t.checkpoints.empty() || !same_until_settling(*t.sim, sim) || t.uniform != uniform ||
+      t.q0.size() != q0.size() || t.q0 != q0 || (uniform && t.times != times))
     return nullptr;
   size_t d = 0;
   while (d < times.size() && d < t.times.size() && times[d] == t.times[d] &&
@@ -158,24 +161,26 @@ const RolloutCheckpoint* resume_point(const Trail& t, const JointVectorRef& q0,
 RolloutResult rollout(Work& w, const Simulator& sim, const JointVectorRef& q0,
                       const std::vector<double>& times, const std::vector<double>& knots,
                       bool uniform, const Trail* also) {
-  const int n = sim.robot.dof;
   const bool resume = w.options.resume;
   const Trail* source = &w.trail;
   const RolloutCheckpoint* from =
-      resume ? resume_point(w.trail, q0, times, knots, uniform, n) : nullptr;
+      resume ? resume_point(w.trail, sim, q0, times, knots, uniform) : nullptr;
   const RolloutCheckpoint* other =
-      resume && also ? resume_point(*also, q0, times, knots, uniform, n) : nullptr;
+      resume && also ? resume_point(*also, sim, q0, times, knots, uniform) : nullptr;
   if (other && (!from || other->tick > from->tick)) {
     source = also;
     from = other;
   }
   Trail& next = w.spare;
+  next.sim = &sim;
   next.q0 = q0;
   next.times = times;
   next.knots = knots;
   next.uniform = uniform;
   next.knot_ticks.clear();
-  for (size_t k = 1; k < times.size(); ++k) next.knot_ticks.push_back(ticks_before(sim, times[k]));
+  if (resume)
+    for (size_t k = 1; k < times.size(); ++k)
+      next.knot_ticks.push_back(ticks_before(sim, times[k]));
   next.checkpoints.clear();
   next.rows.clear();
   if (from) {  // the shared part: its rows and the checkpoints before the one gone on from
@@ -183,7 +188,7 @@ RolloutResult rollout(Work& w, const Simulator& sim, const JointVectorRef& q0,
       if (c.tick < from->tick) next.checkpoints.push_back(c);
     next.rows.assign(source->rows.begin(), source->rows.begin() + from->tick_values);
   }
-  const CommandProfile p{knots.data(), static_cast<int>(times.size()), n, times.back(),
+  const CommandProfile p{knots.data(), static_cast<int>(times.size()), sim.robot.dof, times.back(),
                          uniform ? nullptr : times.data()};
   const RolloutResult r = simulate(sim, w.ws, q0, p, {nullptr, nullptr, 0, &next.rows},
                                    {from, &next.knot_ticks, &next.checkpoints});
@@ -196,7 +201,8 @@ RolloutResult rollout(Work& w, const Simulator& sim, const JointVectorRef& q0,
 // (knots [first, last) carry the correction) up to max_corrections times. `offset` is the
 // predicted end offset before any simulation (the start's offset from the raw chain).
 // `uniform`: the knots are evenly spaced, simulated as such (a raw step alone is then its own
-// bundle command, bit for bit). A correction round goes on from where it changes the command.
+// bundle command, bit for bit). A correction round goes on from where it changes the command
+// when that is after the command's second knot (a joined command's last step).
 RolloutResult simulate_to_target(Work& w, const JointVectorRef& q0, std::vector<double>& times,
                                  std::vector<double>& knots, int first, int last,
                                  const JointVector& target, const JointVector& predicted_offset,

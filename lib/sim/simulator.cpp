@@ -313,9 +313,22 @@ class EndEffectorTrack {
 
 int ticks_before(const Simulator& sim, double t) {
   constexpr double kMargin = 1e-9;  // s: a tick at the change (up to rounding) counts as after
-  int tick = 0;
-  while (tick * sim.dt < t - kMargin) ++tick;
+  if (!(t - kMargin > 0)) return 0;
+  // From the estimate, settled with the comparison simulate's tick times make.
+  int tick = static_cast<int>(std::min(std::floor((t - kMargin) / sim.dt), 2e9));
+  while (tick > 0 && !((tick - 1) * sim.dt < t - kMargin)) --tick;
+  while (tick < 2000000000 && tick * sim.dt < t - kMargin) ++tick;
   return tick;
+}
+
+bool same_until_settling(const Simulator& a, const Simulator& b) {
+  const SimulationOptions &x = a.options, &y = b.options;
+  const EndEffectorLimits &e = a.end_effector, &f = b.end_effector;
+  return &a.robot == &b.robot && &a.collision == &b.collision && a.dt == b.dt &&
+         x.integrator == y.integrator && x.substeps == y.substeps && e.link == f.link &&
+         e.max_linear_speed == f.max_linear_speed &&
+         e.max_linear_acceleration == f.max_linear_acceleration && e.max_tilt == f.max_tilt &&
+         e.axis == f.axis;
 }
 
 namespace {
@@ -363,6 +376,8 @@ int start_rollout(const Simulator& sim, SimulatorWorkspace& ws, const Trajectory
                   EndEffectorTrack& end_effector) {
   if (from) {
     if (samples.q) fail("simulate", "a resumed rollout takes no float samples");
+    if ((samples.ticks ? samples.ticks->size() : 0) != from->tick_values)
+      fail("simulate", "a resumed rollout needs the tick rows up to its checkpoint");
     s = TickState{from->q, from->dq, from->tau_prev, from->ddq_prev, from->moved};
     result = from->partial;
     end_effector.set_velocity(from->end_effector_velocity);

@@ -116,8 +116,9 @@ struct TrajectorySamples {
 };
 
 // A rollout's state at the start of a control tick: enough to go on from there exactly as the
-// rollout it was saved from (bit for bit), for a command that agrees with that rollout's
-// command at every earlier tick (issue 27: a corrected command re-simulates only what changed).
+// rollout it was saved from (bit for bit), from the same start, for a command that agrees with
+// that rollout's command at every earlier tick, with a simulator that agrees with its
+// simulator until the command ends (same_until_settling; issue 27: simulate only what changed).
 struct RolloutCheckpoint {
   int tick = -1;  // -1: none saved
   JointVector q, dq, tau_prev, ddq_prev;
@@ -135,6 +136,11 @@ struct RolloutResume {
   const std::vector<int>* save_at = nullptr;
   std::vector<RolloutCheckpoint>* saved = nullptr;
 };
+
+// Whether rollouts of `a` and `b` agree tick for tick until their command ends: the same robot,
+// collision model, integration and task limits; only the settle may differ (settle_velocity,
+// max_settle_time and settle_for_stop act once the command has ended).
+bool same_until_settling(const Simulator& a, const Simulator& b);
 
 // The first tick whose command time (tick * dt, as simulate computes it) is not before t by a
 // margin: a command changed from time t on leaves every earlier tick as it was.
