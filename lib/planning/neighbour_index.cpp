@@ -273,15 +273,8 @@ void EdgeIndex::within(const double* q, double radius,
   if (m.rows == nullptr) return;
   const double r2 = radius * radius;
   const bool leaf_ordered = !m.leaf_rows.empty();
-  Search s{m.arrays,
-           leaf_ordered ? m.leaf_rows.data() : m.rows,
-           leaf_ordered,
-           m.dof,
-           q,
-           r2,
-           r2 * (1 + 1e-9),
-           {},
-           out};
+  const double* rows = leaf_ordered ? m.leaf_rows.data() : m.rows;
+  Search s{m.arrays, rows, leaf_ordered, m.dof, q, r2, r2 * (1 + 1e-9), {}, out};
   double bound = 0;
   for (int d = 0; d < m.dof; ++d) {
     const double gap = std::max({m.arrays.lower[d] - q[d], q[d] - m.arrays.upper[d], 0.0});

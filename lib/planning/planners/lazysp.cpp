@@ -493,6 +493,8 @@ class LazySp final : public BundlePlanner {
 
 }  // namespace
 
+static_assert(kGoalConnectRadius == 1.0, "connect_radius's description says 1 rad");
+
 PlannerInfo lazysp_planner_info() {
   PlannerInfo info;
   info.name = "lazysp";
@@ -523,6 +525,7 @@ PlannerInfo lazysp_planner_info() {
       real_parameter("mark_weight", 2.0, 0, false,
                      "rad of cost added per edge a scene other than the bundle's may block "
                      "(workspace index), in the first search of each round"),
+      // The text names kGoalConnectRadius's value (schemas/query.schema.json too).
       real_parameter("connect_radius", 1.0, 0, false,
                      "rad: a new real state this near a joint goal tries the direct command to "
                      "it (0: never; pose goals and goal sets always try within 1 rad)"),
