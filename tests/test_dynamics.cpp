@@ -81,6 +81,29 @@ TEST(Dynamics, MassMatrixMatchesJacobianFormulation) {
   }
 }
 
+// The dynamics read each body's inertia about its origin, which merge_inertia keeps: a payload
+// merged into the hand after the model was read must change the mass matrix and the gravity
+// torques as the centre-of-mass description says.
+TEST(Dynamics, AMergedPayloadReachesTheDynamics) {
+  RobotModel robot = test::panda();
+  Eigen::Matrix3d box = Eigen::Matrix3d::Zero();
+  box.diagonal() << 2e-3, 3e-3, 4e-3;
+  merge_inertia(robot.bodies.back(), 1.5, Eigen::Vector3d(0.02, -0.01, 0.12), box);
+  RobotData data(robot), unloaded(test::panda());
+  std::mt19937_64 rng(12);
+  for (int trial = 0; trial < 20; ++trial) {
+    const State s = random_state(robot, rng);
+    const JointMatrix reference = mass_matrix_from_jacobians(robot, s.q);
+    EXPECT_LT((mass_matrix(robot, data, s.q) - reference).norm(), 1e-10 * reference.norm());
+    dynamics_terms(robot, data, s.q, s.dq);
+    EXPECT_LT((data.M - reference).norm(), 1e-10 * reference.norm());
+    EXPECT_GT((data.M - mass_matrix(test::panda(), unloaded, s.q)).norm(), 1e-3);
+    const JointVector g = gravity_torques(robot, data, s.q);  // Newton-Euler, from the com
+    dynamics_terms(robot, data, s.q, s.dq);
+    EXPECT_LT((data.gravity - g).norm(), 1e-10 * g.norm());
+  }
+}
+
 TEST(Dynamics, InverseDynamicsEqualsMassMatrixTimesAccelerationPlusBias) {
   const RobotModel& robot = test::panda();
   RobotData data(robot);

@@ -102,8 +102,8 @@ TEST(Registry, NamesAndLookups) {
             (std::set<std::string>{"theta", "lazy_model", "goal_bias", "selection_radius",
                                    "pruning_ratio", "epsilon", "resolution", "risk_weight",
                                    "edge_penalty", "expansion_limit", "mark_weight", "direct",
-                                   "connect_radius", "candidate_radius"}));
-  EXPECT_EQ(all.size(), 14u);  // each once
+                                   "connect_radius", "candidate_radius", "precheck"}));
+  EXPECT_EQ(all.size(), 15u);  // each once
 }
 
 // The refusals only: a planner registered here would stay for the other tests of a process that

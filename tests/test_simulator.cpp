@@ -64,7 +64,11 @@ TEST(CommandProfile, StartsAndEndsAtRestWithinLimitsAtControlRate) {
         }
       }
       evaluate_command(p, tick * dt, v, a, off);
+      double v_alone[7], a_alone[7];
+      evaluate_command(p, tick * dt, v_alone, a_alone, nullptr);  // the simulator's call
       for (int i = 0; i < 7; ++i) {
+        EXPECT_EQ(v_alone[i], v[i]);
+        EXPECT_EQ(a_alone[i], a[i]);
         EXPECT_LE(std::abs(v[i]), robot.dq_max[i]);
         // Finite differences at 1 kHz, as the robot's controller checks the stream.
         const double acc = (v[i] - v_prev[i]) / dt, jerk = (acc - a_prev[i]) / dt;

@@ -91,6 +91,13 @@ class SearchState {
     return static_cast<int>(nodes_.size()) - 1;
   }
 
+  // Whether q passes the simulator's check of a state (limits, collisions, tilt), counted as a
+  // collision check: a look at a predicted motion before simulating it.
+  bool state_free(const JointVectorRef& q) {
+    ++result_.counters.collision_checks;
+    return check_state(ctx_.sim, ws_, q) == RolloutStatus::Valid;
+  }
+
   RolloutResult simulate_from(const JointVectorRef& q, const CommandProfile& profile) {
     const RolloutResult r = simulate(ctx_.sim, ws_, q, profile);
     count(r);

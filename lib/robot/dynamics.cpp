@@ -85,23 +85,6 @@ inline Eigen::Vector3d axis_cross(const Joint& j, const Eigen::Vector3d& v) {
   return j.axis_is_z ? Eigen::Vector3d(-v.y(), v.x(), 0.0) : Eigen::Vector3d(j.axis.cross(v));
 }
 
-// The body's inertia about its origin: I_O = I_com + m (|c|^2 1 - c c^T) (parallel axes).
-inline void origin_inertia(const BodyInertia& body, OriginInertia& out) {
-  const Eigen::Vector3d& c = body.com;
-  const double m = body.mass;
-  const Eigen::Vector3d h = m * c;
-  const Eigen::Matrix3d& I = body.inertia_com;
-  Eigen::Matrix3d& J = out.rotational;
-  J(0, 0) = I(0, 0) + (h.y() * c.y() + h.z() * c.z());
-  J(1, 1) = I(1, 1) + (h.x() * c.x() + h.z() * c.z());
-  J(2, 2) = I(2, 2) + (h.x() * c.x() + h.y() * c.y());
-  J(1, 0) = J(0, 1) = I(0, 1) - h.x() * c.y();
-  J(2, 0) = J(0, 2) = I(0, 2) - h.x() * c.z();
-  J(2, 1) = J(1, 2) = I(1, 2) - h.y() * c.z();
-  out.mass = m;
-  out.first_moment = h;
-}
-
 // Adds `child` (about its own origin, in its frame; X = child frame in `into`'s frame) to
 // `into`. With h' = R h_child and u = m_child p + h' (the first moment it adds):
 //   I += R I_child R^T + (m |p|^2 + 2 p.h') 1 - u p^T - p h'^T,
@@ -197,7 +180,7 @@ void mass_matrix_from_composites(const RobotModel& model, RobotData& data, bool 
 void composite_inertias(const RobotModel& model, RobotData& data) {
   const int n = model.dof;
   for (int i = n - 1; i >= 0; --i) {
-    origin_inertia(model.bodies[i], data.composite[i]);
+    data.composite[i] = model.bodies[i].about_origin;
     if (i + 1 < n)
       add_child_inertia(data.composite[i], data.composite[i + 1], data.joint_pose[i + 1]);
   }
@@ -243,7 +226,7 @@ void velocity_terms_and_composites(const RobotModel& model, RobotData& data,
       a += 2.0 * w.cross(j.axis * dq[i]);
     }
     OriginInertia& body = data.composite[i];
-    origin_inertia(model.bodies[i], body);
+    body = model.bodies[i].about_origin;
     const Eigen::Vector3d& h = body.first_moment;
     const Eigen::Matrix3d& I = body.rotational;
     data.force[i] = body.mass * a + dw.cross(h) + w.cross(w.cross(h));

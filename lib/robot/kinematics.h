@@ -7,16 +7,6 @@
 
 namespace lazyboe {
 
-// Inertia of a rigid body (or of a body with everything it carries) about the body's origin, in
-// the body frame: what the composite-rigid-body pass merges and the Newton-Euler pass multiplies
-// with. About the origin, merging needs no centre-of-mass shifts (spatial inertia as in
-// Featherstone, "Rigid Body Dynamics Algorithms", 2008, ch. 2).
-struct OriginInertia {
-  double mass = 0;
-  Eigen::Vector3d first_moment = Eigen::Vector3d::Zero();  // mass times centre of mass
-  Eigen::Matrix3d rotational = Eigen::Matrix3d::Zero();    // about the origin; symmetric
-};
-
 // Scratch space for one thread: sized once from the model, then reused without allocating.
 struct RobotData {
   explicit RobotData(const RobotModel& model);

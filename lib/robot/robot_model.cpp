@@ -8,6 +8,26 @@
 #include "lazyboe/common/text.h"
 
 namespace lazyboe {
+namespace {
+
+// The body's inertia about its origin: I_O = I_com + m (|c|^2 1 - c c^T) (parallel axes).
+void origin_inertia(const BodyInertia& body, OriginInertia& out) {
+  const Eigen::Vector3d& c = body.com;
+  const double m = body.mass;
+  const Eigen::Vector3d h = m * c;
+  const Eigen::Matrix3d& I = body.inertia_com;
+  Eigen::Matrix3d& J = out.rotational;
+  J(0, 0) = I(0, 0) + (h.y() * c.y() + h.z() * c.z());
+  J(1, 1) = I(1, 1) + (h.x() * c.x() + h.z() * c.z());
+  J(2, 2) = I(2, 2) + (h.x() * c.x() + h.y() * c.y());
+  J(1, 0) = J(0, 1) = I(0, 1) - h.x() * c.y();
+  J(2, 0) = J(0, 2) = I(0, 2) - h.x() * c.z();
+  J(2, 1) = J(1, 2) = I(1, 2) - h.y() * c.z();
+  out.mass = m;
+  out.first_moment = h;
+}
+
+}  // namespace
 
 void merge_inertia(BodyInertia& into, double mass, const Eigen::Vector3d& com,
                    const Eigen::Matrix3d& inertia_com) {
@@ -21,6 +41,7 @@ void merge_inertia(BodyInertia& into, double mass, const Eigen::Vector3d& com,
       into.inertia_com + shift(into.mass, into.com - c) + inertia_com + shift(mass, com - c);
   into.com = c;
   into.mass = total;
+  origin_inertia(into, into.about_origin);
 }
 
 const char* shape_type_name(ShapeType type) {

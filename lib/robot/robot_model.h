@@ -43,11 +43,24 @@ struct Joint {
   Friction friction;
 };
 
-// Inertia of one moving body (its link plus every link fixed to it), in the body frame.
+// Inertia of a rigid body (or of a body with everything it carries) about the body's origin, in
+// the body frame: what the composite-rigid-body pass merges and the Newton-Euler pass multiplies
+// with. About the origin, merging needs no centre-of-mass shifts (spatial inertia as in
+// Featherstone, "Rigid Body Dynamics Algorithms", 2008, ch. 2).
+struct OriginInertia {
+  double mass = 0;
+  Eigen::Vector3d first_moment = Eigen::Vector3d::Zero();  // mass times centre of mass
+  Eigen::Matrix3d rotational = Eigen::Matrix3d::Zero();    // about the origin; symmetric
+};
+
+// Inertia of one moving body (its link plus every link fixed to it), in the body frame. Written
+// only through merge_inertia, which keeps `about_origin` (what the dynamics use every tick) in
+// step with the other three.
 struct BodyInertia {
   double mass = 0;
   Eigen::Vector3d com = Eigen::Vector3d::Zero();
   Eigen::Matrix3d inertia_com = Eigen::Matrix3d::Zero();  // about the centre of mass
+  OriginInertia about_origin;                             // the same, about the body's origin
 };
 
 // "revolute", "continuous" or "prismatic", as the URDF says.

@@ -46,11 +46,12 @@ void evaluate_timed_command(const CommandProfile& p, double t, double* velocity,
   const double* times = p.times;
   if (t >= p.duration) {
     for (int i = 0; i < n; ++i) {
+      velocity[i] = 0;
+      acceleration[i] = 0;
+      if (!offset) continue;
       double sum = 0;
       for (int j = 0; j < last; ++j)
         sum += 0.5 * (times[j + 1] - times[j]) * (p.knots[j * n + i] + p.knots[(j + 1) * n + i]);
-      velocity[i] = 0;
-      acceleration[i] = 0;
       offset[i] = sum;
     }
     return;
@@ -63,12 +64,13 @@ void evaluate_timed_command(const CommandProfile& p, double t, double* velocity,
   const double ds = 30 * tau2 * (1 - 2 * tau + tau2);
   const double S = tau2 * tau2 * (2.5 - 3 * tau + tau2);
   for (int i = 0; i < n; ++i) {
-    double sum = 0;
-    for (int j = 0; j < k; ++j)
-      sum += 0.5 * (times[j + 1] - times[j]) * (p.knots[j * n + i] + p.knots[(j + 1) * n + i]);
     const double va = p.knots[k * n + i], dv = p.knots[(k + 1) * n + i] - va;
     velocity[i] = va + dv * s;
     acceleration[i] = dv * ds / h;
+    if (!offset) continue;
+    double sum = 0;
+    for (int j = 0; j < k; ++j)
+      sum += 0.5 * (times[j + 1] - times[j]) * (p.knots[j * n + i] + p.knots[(j + 1) * n + i]);
     offset[i] = sum + h * (va * tau + dv * S);
   }
 }
@@ -88,11 +90,12 @@ void evaluate_command(const CommandProfile& p, double t, double* velocity, doubl
   int k = static_cast<int>(std::floor(t / h));
   if (t >= p.duration || k >= last) {
     for (int i = 0; i < n; ++i) {
+      velocity[i] = 0;
+      acceleration[i] = 0;
+      if (!offset) continue;
       double sum = 0;
       for (int j = 0; j < last; ++j)
         sum += 0.5 * h * (p.knots[j * n + i] + p.knots[(j + 1) * n + i]);
-      velocity[i] = 0;
-      acceleration[i] = 0;
       offset[i] = sum;
     }
     return;
@@ -104,11 +107,12 @@ void evaluate_command(const CommandProfile& p, double t, double* velocity, doubl
   const double ds = 30 * tau2 * (1 - 2 * tau + tau2);
   const double S = tau2 * tau2 * (2.5 - 3 * tau + tau2);  // integral of s from 0 to tau
   for (int i = 0; i < n; ++i) {
-    double sum = 0;
-    for (int j = 0; j < k; ++j) sum += 0.5 * h * (p.knots[j * n + i] + p.knots[(j + 1) * n + i]);
     const double va = p.knots[k * n + i], dv = p.knots[(k + 1) * n + i] - va;
     velocity[i] = va + dv * s;
     acceleration[i] = dv * ds / h;
+    if (!offset) continue;
+    double sum = 0;
+    for (int j = 0; j < k; ++j) sum += 0.5 * h * (p.knots[j * n + i] + p.knots[(j + 1) * n + i]);
     offset[i] = sum + h * (va * tau + dv * S);
   }
 }

@@ -40,7 +40,9 @@ double sample_command_profile(const RobotModel& robot, const CommandSampling& sa
                               std::vector<double>& knots);
 
 // Velocity, acceleration and the integral of the velocity from t = 0 (the position reference
-// offset) at time t; beyond the duration the command is zero and the offset constant.
+// offset) at time t; beyond the duration the command is zero and the offset constant. `offset`
+// may be null: the simulator does not use it, and its sum over the earlier intervals is the
+// costly part (every settle tick summed the whole command).
 void evaluate_command(const CommandProfile& profile, double t, double* velocity,
                       double* acceleration, double* offset);
 

@@ -121,9 +121,10 @@ RolloutStatus check_state(const Simulator& sim, SimulatorWorkspace& ws, const Jo
   }
   forward_kinematics(robot, ws.robot, q);
   update_collision_transforms(sim.collision, ws.collision, ws.robot);
-  const CollisionReport report = check_collision(sim.collision, ws.collision);
-  if (report.env_collision) return RolloutStatus::EnvCollision;
-  if (report.self_collision) return RolloutStatus::SelfCollision;
+  if (in_collision(sim.collision, ws.collision)) {  // the full report only to name the kind
+    const CollisionReport report = check_collision(sim.collision, ws.collision);
+    return report.env_collision ? RolloutStatus::EnvCollision : RolloutStatus::SelfCollision;
+  }
   if (sim.end_effector.any() &&
       !(end_effector_tilt(robot, ws.robot, sim.end_effector) <= sim.end_effector.max_tilt))
     return RolloutStatus::EndEffectorTilt;
@@ -408,7 +409,7 @@ RolloutResult simulate(const Simulator& sim, SimulatorWorkspace& ws, const Joint
   TickState s{q0_in, JointVector::Zero(n), {}, JointVector::Zero(n), 0};
   JointVector& q = s.q;
   JointVector& dq = s.dq;
-  JointVector q_prev = q, v_cmd(n), a_cmd(n), offset(n), tau(n);
+  JointVector q_prev = q, v_cmd(n), a_cmd(n), tau(n);
   Stages k(n);
   JointVector ddq(n);
   const JointVector tau_rate_max = robot.dtau_max * dt;
@@ -432,7 +433,7 @@ RolloutResult simulate(const Simulator& sim, SimulatorWorkspace& ws, const Joint
   for (int tick = first_tick; tick < max_ticks; ++tick) {
     if (saver.due(tick)) saver.save(s, result, tick, end_effector.velocity(), samples);
     const double t = tick * dt;
-    evaluate_command(profile, t, v_cmd.data(), a_cmd.data(), offset.data());
+    evaluate_command(profile, t, v_cmd.data(), a_cmd.data(), nullptr);
 
     // Mass matrix, gravity and velocity terms at this tick's state, shared by the controller
     // and the first integration step.
