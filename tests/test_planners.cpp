@@ -729,6 +729,8 @@ TEST(LazySp, ANarrowJointGoalIsReachedByTheDirectCommandFromANearState) {
 struct BlockedScene {
   BlockedScene(const Fixture& f, const Environment& env)
       : collision(build_collision_model(f.robot, env)), sim(f.robot, collision, f.sim.options) {}
+  BlockedScene(const BlockedScene&) = delete;  // sim refers to this object's collision model
+  BlockedScene& operator=(const BlockedScene&) = delete;
   CollisionModel collision;
   Simulator sim;  // refers to `collision`
 };
@@ -808,6 +810,9 @@ TEST(LazySp, TheLookBeforeSimulatingSeesTheObstacle) {
   ASSERT_TRUE(without.success) << without.failure;
   ASSERT_TRUE(looked.success) << looked.failure;
   EXPECT_LT(looked.counters.simulations, without.counters.simulations);
+  // Every simulation is a step of the answer: none was spent on an edge the ball blocks.
+  EXPECT_EQ(looked.found_by, "bundle");
+  EXPECT_EQ(looked.counters.simulations, looked.best_path.size());
   expect_revalidated(f, scene->sim, p, looked);
   std::cout << "[ lazysp  ] the look: " << looked.counters.simulations << " simulations against "
             << without.counters.simulations << " without it\n";

@@ -2,7 +2,7 @@
 // --resume/--inspect and lazyboe-perturb; BundleView::open for lazyboe-query and lazyboe-bench):
 // the offsets index their datasets, and every number is finite and within its range. One
 // streaming pass over the arrays given; an array left null is not checked (the view does not
-// read the trajectory samples, which the planners never use). The first problem is an Error
+// check the trajectory samples, which never decide validity). The first problem is an Error
 // naming the file, the dataset, the edge and the value.
 #pragma once
 

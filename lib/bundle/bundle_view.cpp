@@ -157,12 +157,16 @@ BundleView BundleView::open(const std::string& path, bool allow_mmap) {
   v.attach_datasets(file, rows, allow_mmap);
   v.check_knot_ranges();
   v.check_values();
-  // lazysp's look reads the samples of the edges it considers: read them ahead, so that the
-  // first queries do not wait on the disk (a cold 100k bundle: first queries 50-500 ms slower).
-  if (v.map_ && n > 0)
-    read_ahead(v.map_.get(), v.map_.get_deleter().bytes, v.samples(0),
-               rows.samples * dof * sizeof(float));
   return v;
+}
+
+void BundleView::read_samples_ahead() const {
+  if (!map_ || edges_ == 0 || !samples_ahead_) return;
+  std::call_once(*samples_ahead_, [this] {
+    const uint64_t rows = arrays_.of<uint64_t>(Id::SampleOffset)[edges_];
+    read_ahead(map_.get(), map_.get_deleter().bytes, samples(0),
+               static_cast<size_t>(rows) * static_cast<size_t>(dof()) * sizeof(float));
+  });
 }
 
 BundleView BundleView::from_memory(std::shared_ptr<const Bundle> bundle, std::string name) {
@@ -203,7 +207,8 @@ void BundleView::check_knot_ranges() const {
 }
 
 // The checks every reader runs (bundle_check.h) on what the view reads, in one pass; not the
-// samples' values, which planning never uses.
+// samples' values, which never decide validity (lazysp's look only steers with them; a
+// non-finite sample fails its state check), so opening does not read them all.
 void BundleView::check_values() const {
   BundleArrays a = arrays_;
   a.set(Id::SampleQ, nullptr);

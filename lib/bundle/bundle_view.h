@@ -8,6 +8,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -73,6 +74,10 @@ class BundleView {
   }
 
   bool memory_mapped() const { return all_mapped_; }  // every dataset mapped
+  // Asks the kernel to read the trajectory samples of a mapped file ahead, without waiting, once
+  // per view (lazysp's look reads the samples of the edges it considers; on a cold page cache
+  // its first queries waited on the disk). Nothing for a view in memory.
+  void read_samples_ahead() const;
   // The checksums stored with the q0 and qf datasets, "<q0> <qf>": what ties an index file
   // (edge_index_file.h) to these edge states. Empty for a file written before checksums and
   // for an in-memory view.
@@ -99,6 +104,7 @@ class BundleView {
   // The read-only mapping of the whole file (unmapped with the view) and datasets read into
   // memory instead (or the in-memory bundle viewed).
   std::unique_ptr<void, FileUnmap> map_;
+  std::unique_ptr<std::once_flag> samples_ahead_ = std::make_unique<std::once_flag>();
   bool all_mapped_ = false;
   std::vector<std::shared_ptr<const void>> owned_;
   std::vector<std::string> warnings_;

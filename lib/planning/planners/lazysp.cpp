@@ -27,8 +27,8 @@ constexpr uint64_t kStream = 2;
 // cost, and grows with them: perf on a cluttered scene with the 100k table bundle, 0.4 ms per
 // rollout, 0.7 us per successor, 37 successors per expansion).
 constexpr double kSuccessorsPerRollout = 500;
-// A state checked for collision before a simulation (looks_free): a rollout runs hundreds of
-// control ticks and tens of such checks.
+// A state checked for collision before a simulation (the look, shifted_samples_free): about
+// 1-2 us against 0.4-1 ms per rollout (perf and the simulator's own checks, clutter scenes).
 constexpr double kChecksPerRollout = 400;
 // Edges, nearest the growth's sample first, whose look a growth step tries before it falls back
 // to a random command.
@@ -98,6 +98,7 @@ class LazySpSearch {
         neighbourhood_(set_.theta *
                        (std::isfinite(ctx_.sim.end_effector.max_tilt) ? kTiltWidening : 1.0)),
         lazy_goal_radius_(lazy_goal_radius(set_, solve.problem.goal)),
+        looks_(set_.precheck && bundle_.header().sample_interval > 0),
         memo_(*ctx_.index, neighbourhood_, ctx_.sim.robot.dof, kMemoBytes) {}
 
   PlanResult run();
@@ -116,7 +117,7 @@ class LazySpSearch {
   bool looks_free(const std::vector<Predicted>& chain);
   bool shifted_samples_free(const JointVector& from, uint32_t e);
   // The edges whose shifted samples collided from a state of `cell`, or null.
-  const std::vector<uint32_t>* blocked_from(uint64_t cell) const {
+  const std::unordered_set<uint32_t>* blocked_from(uint64_t cell) const {
     if (blocked_.empty()) return nullptr;
     const auto it = blocked_.find(cell);
     return it == blocked_.end() ? nullptr : &it->second;
@@ -192,11 +193,14 @@ class LazySpSearch {
   const EdgeLinkMotion* const motions_;  // breaks_task
   const double neighbourhood_;     // radius of a predicted state's edges: theta, wider under tilt
   const double lazy_goal_radius_;  // lazy_in_goal's, for a joint goal
+  // precheck, on a bundle with stored samples to look at (else the look would pass everything
+  // and the growth would never use random commands)
+  const bool looks_;
   NeighbourMemo memo_;             // expand's radius queries, across rounds
   bool goal_covered_ = true;
   std::unordered_set<uint64_t> tried_;  // (real node, edge) pairs simulated, valid or not
   // By the cell of a source state: edges whose stored samples, shifted there, collided (precheck).
-  std::unordered_map<uint64_t, std::vector<uint32_t>> blocked_;
+  std::unordered_map<uint64_t, std::unordered_set<uint32_t>> blocked_;
   JointVector probe_;  // shifted_samples_free's scratch
   std::vector<std::pair<double, uint32_t>> ranked_;  // grow_along_bundle's scratch
   std::vector<PathStep> commands_;      // the growth's commands, by LazySpNode::command
@@ -214,7 +218,8 @@ class LazySpSearch {
   bool exhausted_ = false;        // the last round found no candidate
   bool use_marks_ = false;        // the search costs the scene's marks
   bool marked_search_ = true;     // rounds still begin with a search that costs them
-  double failed_candidates_ = 0;  // validated without reaching the goal
+  // Validated without reaching the goal, plus kRejectedCandidate per candidate the look rejected.
+  double failed_candidates_ = 0;
   size_t reals_at_exhaustion_ = 0;
 };
 
@@ -269,7 +274,7 @@ void LazySpSearch::lazy_round() {
   if (!found) found = candidate(expansions, set_.expansion_limit, false, chain);
   const uint64_t checked = prechecks_;
   // A candidate the look rejects costs no simulation; it counts a fraction of a failed one.
-  const bool looked = found && (!set_.precheck || looks_free(chain));
+  const bool looked = found && (!looks_ || looks_free(chain));
   if (looked && !validate(chain)) ++failed_candidates_;
   if (found && !looked) failed_candidates_ += kRejectedCandidate;
   lazy_work_ += static_cast<double>(successors_ - generated) / kSuccessorsPerRollout +
@@ -331,14 +336,14 @@ int LazySpSearch::expand(int p) {
   const NeighbourMemo::Span near = memo_.within(from_.data());
   successors_ += near.count;
   const int n = bundle_.dof();
-  const std::vector<uint32_t>* blocked = blocked_from(preds_[p].cell);
+  const std::unordered_set<uint32_t>* blocked = blocked_from(preds_[p].cell);
   int goal = -1;
   double goal_g = std::numeric_limits<double>::infinity();
   for (size_t k = 0; k < near.count; ++k) {
     const uint32_t e = near.edges[k];
     // From a real state, an edge simulated before is known: its real end is a source itself.
     if (real >= 0 && tried_.count(key(real, e))) continue;
-    if (blocked && std::find(blocked->begin(), blocked->end(), e) != blocked->end()) continue;
+    if (blocked && blocked->count(e)) continue;
     step_ = Eigen::Map<const Eigen::VectorXd>(bundle_.qf(e), n) -
             Eigen::Map<const Eigen::VectorXd>(bundle_.q0(e), n);
     next_ = from_ + step_;
@@ -420,7 +425,7 @@ bool LazySpSearch::validate(const std::vector<Predicted>& chain) {
 bool LazySpSearch::looks_free(const std::vector<Predicted>& chain) {
   for (size_t k = 1; k < chain.size(); ++k) {
     if (shifted_samples_free(chain[k - 1].q, chain[k].edge)) continue;
-    blocked_[chain[k - 1].cell].push_back(chain[k].edge);
+    blocked_[chain[k - 1].cell].insert(chain[k].edge);
     return false;
   }
   return true;
@@ -439,14 +444,15 @@ bool LazySpSearch::shifted_samples_free(const JointVector& from, uint32_t e) {
   return true;
 }
 
-// One RRT step from the real nodes: a goal-biased sample, its nearest real node, a random
-// command of the bundle's family.
+// One RRT step from the real nodes: a goal-biased sample, its nearest real node, then a bundle
+// edge from it that looks free (grow_along_bundle) or else a random command of the bundle's
+// family.
 void LazySpSearch::grow() {
   const int n = ctx_.sim.robot.dof;
   JointVector x(n);
   sample_state(ctx_, s_.problem(), set_.goal_bias, rng_, x);
   const int from = nearest_node(s_.nodes(), x, [](int) { return true; });
-  if (set_.precheck && grow_along_bundle(from, x)) return;
+  if (looks_ && grow_along_bundle(from, x)) return;
   std::vector<double> knots;
   const double duration = sample_command_profile(ctx_.sim.robot, ctx_.command, rng_, knots);
   const CommandProfile profile{knots.data(), static_cast<int>(knots.size() / n), n, duration};
@@ -470,23 +476,24 @@ void LazySpSearch::reached_by_growth(int c) {
 
 // The growth's step along the bundle: of the edges from real node `from`, those whose predicted
 // ends come nearest the sample x, in that order, the first whose shifted samples look free
-// (looks_free), simulated; false when none of the nearest kGrowthTries looks free (then a random
+// (shifted_samples_free), simulated; false when none of the nearest kGrowthTries looks free (then a random
 // command, as RRT). An edge picked from hundreds goes where the sample is, where one random
 // command goes anywhere.
 bool LazySpSearch::grow_along_bundle(int from, const JointVector& x) {
   const JointVector q = s_.node(from).q;
   const uint64_t source_cell = cell(q);
   const NeighbourMemo::Span near = memo_.within(q.data());
-  const std::vector<uint32_t>* blocked = blocked_from(source_cell);
+  growth_work_ += static_cast<double>(near.count) / kSuccessorsPerRollout;
+  const std::unordered_set<uint32_t>* blocked = blocked_from(source_cell);
   const int n = bundle_.dof();
   ranked_.clear();
   for (size_t k = 0; k < near.count; ++k) {
     const uint32_t e = near.edges[k];
     if (tried_.count(key(from, e)) || breaks_task(e)) continue;
-    if (blocked && std::find(blocked->begin(), blocked->end(), e) != blocked->end()) continue;
+    if (blocked && blocked->count(e)) continue;
     next_ = q + (Eigen::Map<const Eigen::VectorXd>(bundle_.qf(e), n) -
                  Eigen::Map<const Eigen::VectorXd>(bundle_.q0(e), n));
-    if (!within_limits(next_)) continue;
+    if (!within_limits(next_) || !s_.within_tilt(next_)) continue;
     ranked_.emplace_back((next_ - x).squaredNorm(), e);
   }
   const size_t tries = std::min(kGrowthTries, ranked_.size());
@@ -495,7 +502,7 @@ bool LazySpSearch::grow_along_bundle(int from, const JointVector& x) {
   for (size_t k = 0; k < tries; ++k) {
     const uint32_t e = ranked_[k].second;
     if (!shifted_samples_free(q, e)) {
-      blocked_[source_cell].push_back(e);
+      blocked_[source_cell].insert(e);
       continue;
     }
     growth_work_ += static_cast<double>(prechecks_ - checked) / kChecksPerRollout;
@@ -589,10 +596,12 @@ class LazySp final : public BundlePlanner {
 
  private:
   // Beyond a bundle, the growth needs a sampling box. A world with end-effector speed or
-  // acceleration limits gets its link's motion table here, in setup, before the solve's clock.
+  // acceleration limits gets its link's motion table here, in setup, before the solve's clock;
+  // the bundle's samples, which the look reads, are asked for ahead (once per bundle).
   void check_context(const PlanningContext& ctx) override {
     check_sampling_box(ctx, name());
     LazySpSearch::task_motions(ctx);
+    if (ctx.bundle) ctx.bundle->read_samples_ahead();
   }
 
   PlanResult search(const BundleSolve& solve) override { return LazySpSearch(solve).run(); }
@@ -606,8 +615,9 @@ PlannerInfo lazysp_planner_info() {
   PlannerInfo info;
   info.name = "lazysp";
   info.description =
-      "lazy shortest path over predicted (transferred) edge ends; simulates only the candidate "
-      "path; grows with random commands where the bundle does not reach; anytime";
+      "lazy shortest path over predicted (transferred) edge ends; looks at a candidate's edges, "
+      "then simulates only the candidate path; grows along bundle edges that look free, else "
+      "by random commands; anytime";
   info.needs.bundle = true;
   ParameterSpec limit = real_parameter(
       "expansion_limit", 20000, 1, false,
