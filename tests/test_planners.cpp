@@ -751,25 +751,44 @@ std::unique_ptr<BlockedScene> blocked_scene(const Fixture& f, const PlanningProb
   return std::make_unique<BlockedScene>(f, env);
 }
 
+// The problem a -> c, its first answer without the look (precheck 0) in the fixture's scene, and
+// that scene with the ball on the answer's way.
+struct BlockedProblem {
+  PlanningProblem p;
+  PlanResult clear;
+  std::unique_ptr<BlockedScene> scene;
+};
+
+const ParameterValues& without_look() {
+  static const ParameterValues values = searching("lazysp", {{"precheck", 0}});
+  return values;
+}
+
+BlockedProblem blocked_problem(const Fixture& f) {
+  BlockedProblem b{library_problem(f.a, f.c, 10), {}, nullptr};
+  b.p.termination.stop_at_first = true;
+  SimulatorWorkspace ws(f.sim);
+  b.clear = plan(session_context(f, f.sim), ws, "lazysp", without_look(), b.p);
+  if (b.clear.success) b.scene = blocked_scene(f, b.p, b.clear);
+  return b;
+}
+
 // Without the look before simulating (precheck 0): the same first candidate (the lazy search
 // simulates nothing) now collides when simulated, and lazysp plans around it instead of
 // returning it.
 TEST(LazySp, ACandidateEdgeThatCollidesIsRepairedAround) {
   const Fixture& f = fixture();
-  PlanningProblem p = library_problem(f.a, f.c, 10);
-  p.termination.stop_at_first = true;
-  SimulatorWorkspace ws(f.sim);
-  const ParameterValues simulating = searching("lazysp", {{"precheck", 0}});
-  const PlanResult clear = plan(session_context(f, f.sim), ws, "lazysp", simulating, p);
-  ASSERT_TRUE(clear.success) << clear.failure;
-  const std::unique_ptr<BlockedScene> scene = blocked_scene(f, p, clear);
-  const Simulator& blocked = scene->sim;
+  const BlockedProblem b = blocked_problem(f);
+  ASSERT_TRUE(b.clear.success) << b.clear.failure;
+  const PlanningProblem& p = b.p;
+  const PlanResult& clear = b.clear;
+  const Simulator& blocked = b.scene->sim;
   SimulatorWorkspace bws(blocked);
   ASSERT_EQ(check_state(blocked, bws, p.start), RolloutStatus::Valid);
   ASSERT_EQ(check_state(blocked, bws, p.goal.q), RolloutStatus::Valid);
   EXPECT_THROW(realize_path(blocked, bws, p.start, clear.best_path, p.goal, 0), Error);
 
-  const PlanResult r = plan(session_context(f, blocked), bws, "lazysp", simulating, p);
+  const PlanResult r = plan(session_context(f, blocked), bws, "lazysp", without_look(), p);
   ASSERT_TRUE(r.success) << r.failure;
   EXPECT_EQ(r.found_by, "bundle");
   EXPECT_GT(r.counters.simulations, r.best_path.size()) << "no simulation failed";
@@ -789,12 +808,11 @@ TEST(LazySp, ACandidateEdgeThatCollidesIsRepairedAround) {
 // answer is as valid. In the bundle's own scene the look changes nothing.
 TEST(LazySp, TheLookBeforeSimulatingSeesTheObstacle) {
   const Fixture& f = fixture();
-  PlanningProblem p = library_problem(f.a, f.c, 10);
-  p.termination.stop_at_first = true;
+  const BlockedProblem b = blocked_problem(f);
+  ASSERT_TRUE(b.clear.success) << b.clear.failure;
+  const PlanningProblem& p = b.p;
+  const PlanResult& clear = b.clear;
   SimulatorWorkspace ws(f.sim);
-  const ParameterValues simulating = searching("lazysp", {{"precheck", 0}});
-  const PlanResult clear = plan(session_context(f, f.sim), ws, "lazysp", simulating, p);
-  ASSERT_TRUE(clear.success) << clear.failure;
   const PlanResult looked_clear =
       plan(session_context(f, f.sim), ws, "lazysp", searching("lazysp"), p);
   ASSERT_TRUE(looked_clear.success) << looked_clear.failure;
@@ -802,10 +820,10 @@ TEST(LazySp, TheLookBeforeSimulatingSeesTheObstacle) {
   EXPECT_EQ(looked_clear.counters.simulations, clear.counters.simulations);
   EXPECT_GT(looked_clear.counters.collision_checks, clear.counters.collision_checks);
 
-  const std::unique_ptr<BlockedScene> scene = blocked_scene(f, p, clear);
-  SimulatorWorkspace bws(scene->sim);
-  const PlanningContext context = session_context(f, scene->sim);
-  const PlanResult without = plan(context, bws, "lazysp", simulating, p);
+  const BlockedScene& scene = *b.scene;
+  SimulatorWorkspace bws(scene.sim);
+  const PlanningContext context = session_context(f, scene.sim);
+  const PlanResult without = plan(context, bws, "lazysp", without_look(), p);
   const PlanResult looked = plan(context, bws, "lazysp", searching("lazysp"), p);
   ASSERT_TRUE(without.success) << without.failure;
   ASSERT_TRUE(looked.success) << looked.failure;
@@ -813,7 +831,7 @@ TEST(LazySp, TheLookBeforeSimulatingSeesTheObstacle) {
   // Every simulation is a step of the answer: none was spent on an edge the ball blocks.
   EXPECT_EQ(looked.found_by, "bundle");
   EXPECT_EQ(looked.counters.simulations, looked.best_path.size());
-  expect_revalidated(f, scene->sim, p, looked);
+  expect_revalidated(f, scene.sim, p, looked);
   std::cout << "[ lazysp  ] the look: " << looked.counters.simulations << " simulations against "
             << without.counters.simulations << " without it\n";
 }

@@ -69,6 +69,16 @@ ParameterSpec real_parameter(const std::string& name, double default_value, doub
   return p;
 }
 
+ParameterSpec boolean_parameter(const std::string& name, bool default_value,
+                                const std::string& description) {
+  ParameterSpec p;
+  p.name = name;
+  p.type = ParameterType::Boolean;
+  p.default_value = default_value ? 1 : 0;
+  p.description = description;
+  return p;
+}
+
 double ParameterValues::get(const std::string& name) const {
   const auto it = values_.find(name);
   if (it == values_.end()) fail(name, "parameter not set");

@@ -121,10 +121,9 @@ RolloutStatus check_state(const Simulator& sim, SimulatorWorkspace& ws, const Jo
   }
   forward_kinematics(robot, ws.robot, q);
   update_collision_transforms(sim.collision, ws.collision, ws.robot);
-  if (in_collision(sim.collision, ws.collision)) {  // the full report only to name the kind
-    const CollisionReport report = check_collision(sim.collision, ws.collision);
-    return report.env_collision ? RolloutStatus::EnvCollision : RolloutStatus::SelfCollision;
-  }
+  const CollisionReport report = check_collision(sim.collision, ws.collision);
+  if (report.env_collision) return RolloutStatus::EnvCollision;
+  if (report.self_collision) return RolloutStatus::SelfCollision;
   if (sim.end_effector.any() &&
       !(end_effector_tilt(robot, ws.robot, sim.end_effector) <= sim.end_effector.max_tilt))
     return RolloutStatus::EndEffectorTilt;

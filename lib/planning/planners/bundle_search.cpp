@@ -73,14 +73,10 @@ ParameterSpec theta_parameter() {
 }
 
 ParameterSpec direct_parameter() {
-  ParameterSpec p;
-  p.name = "direct";
-  p.type = ParameterType::Boolean;
-  p.default_value = 1;
-  p.description =
+  return boolean_parameter(
+      "direct", true,
       "first simulate the straight command from the start to a joint goal; when it arrives, it "
-      "is the answer (found_by: direct) and no search runs";
-  return p;
+      "is the answer (found_by: direct) and no search runs");
 }
 
 double bundle_planner_setup(const PlanningContext& ctx, const ParameterValues& values,
