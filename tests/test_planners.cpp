@@ -836,5 +836,73 @@ TEST(LazySp, TheLookBeforeSimulatingSeesTheObstacle) {
             << without.counters.simulations << " without it\n";
 }
 
+// A narrow joint goal (1 cm) behind a ball: the ball sits where the hand passes on the direct
+// command into the goal that solves the problem in the fixture's scene, so the direct commands
+// from that side collide. With approaches lazysp comes in along a bundle edge looked at backward
+// from the goal (found_by "approach": the last steps are the straight command to the approach,
+// a bundle edge, and at most one more direct command); without them it does not.
+constexpr double kPocketAlong = 0.4;  // of the way: the goal and the start stay free of the ball
+struct PocketProblem {
+  PlanningProblem p;
+  std::unique_ptr<BlockedScene> scene;
+};
+
+PocketProblem pocket_problem(const Fixture& f, double along) {
+  PocketProblem b{library_problem(f.a, f.c, 10), nullptr};
+  b.p.goal.tolerance = 0.01;
+  b.p.termination.stop_at_first = true;
+  SimulatorWorkspace ws(f.sim);
+  const PlanResult open = plan(session_context(f, f.sim), ws, "lazysp",
+                               searching("lazysp", {{"connect_radius", 1.0}}), b.p);
+  if (!open.success || open.found_by != "connection") return b;
+  const Trajectory t = realize_path(f.sim, ws, b.p.start, open.best_path, b.p.goal, kSampleEvery);
+  // The hand on the last step (the direct command), `along` of the way from its start.
+  const double t0 = t.t.back() - open.best_path.back().outcome->duration;
+  size_t k = 0;
+  while (k + 1 < t.t.size() && t.t[k] < t0 + along * (t.t.back() - t0)) ++k;
+  RobotData data(f.robot);
+  forward_kinematics(f.robot, data, t.q[k]);
+  Environment env = f.env;
+  Obstacle ball;
+  ball.name = "pocket";
+  ball.shape.type = ShapeType::Sphere;
+  ball.shape.radius = 0.03;
+  ball.pose.p = link_pose(f.robot, data, f.robot.tip_link()).p;
+  env.obstacles.push_back(ball);
+  b.scene = std::make_unique<BlockedScene>(f, env);
+  return b;
+}
+
+TEST(LazySp, AGoalInAPocketIsApproachedAlongAnEdgeLookedAtBackward) {
+  const Fixture& f = fixture();
+  const PocketProblem b = pocket_problem(f, kPocketAlong);
+  ASSERT_TRUE(b.scene) << "the open scene's answer is not a direct command into the goal";
+  const Simulator& pocket = b.scene->sim;
+  SimulatorWorkspace ws(pocket);
+  ASSERT_EQ(check_state(pocket, ws, b.p.start), RolloutStatus::Valid);
+  ASSERT_EQ(check_state(pocket, ws, b.p.goal.q), RolloutStatus::Valid);
+  const PlanningContext context = session_context(f, pocket);
+  const PlanResult r =
+      plan(context, ws, "lazysp", searching("lazysp", {{"connect_radius", 1.0}}), b.p);
+  ASSERT_TRUE(r.success) << r.failure;
+  EXPECT_EQ(r.found_by, "approach");
+  const std::vector<PathStep>& path = r.best_path;
+  ASSERT_GE(path.size(), 3u);
+  const size_t edge = path.back().bundle_edge >= 0 ? path.size() - 1 : path.size() - 2;
+  EXPECT_GE(path[edge].bundle_edge, 0);       // the approach's edge
+  EXPECT_EQ(path[edge - 1].bundle_edge, -1);  // the straight command to the approach
+  expect_revalidated(f, pocket, b.p, r);
+
+  const PlanResult without =
+      plan(context, ws, "lazysp", searching("lazysp", {{"connect_radius", 1.0}, {"approaches", 0}}),
+           b.p);
+  EXPECT_NE(without.found_by, "approach");
+  EXPECT_FALSE(without.success && without.counters.simulations <= r.counters.simulations)
+      << "without approaches as cheap: the test shows nothing";
+  std::cout << "[ lazysp  ] pocket: " << r.counters.simulations << " simulations with approaches, "
+            << without.counters.simulations << " without ("
+            << (without.success ? "solved" : "not solved") << ")\n";
+}
+
 }  // namespace
 }  // namespace lazyboe::test

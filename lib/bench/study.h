@@ -75,7 +75,7 @@ struct RunRecord {
   // budget): time to first solution + post_seconds is the time to an executable trajectory.
   double post_seconds = 0;
   int junctions = -1, blends_kept = -1, shortcuts = -1;
-  std::string found_by;  // PlanResult::found_by ("direct", "bundle", "growth", "connection", ...)
+  std::string found_by;  // PlanResult::found_by ("direct", "bundle", "growth", "connection", "approach", ...)
 };
 
 // The seed of a (problem, repeat) run: the same for every planner, different across repeats.

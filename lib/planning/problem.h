@@ -145,8 +145,9 @@ struct PlanResult {
   PlannerCounters counters;
   std::string failure;  // why there is no solution
   // Which part of the planner found the best path, for planners with several: "direct" (the
-  // bundle planners' straight command, tried first), "bundle", "growth" or "connection"
-  // (lazysp's search, growth, or direct command into the goal from a near state); "start" for
+  // bundle planners' straight command, tried first), "bundle", "growth", "connection" or
+  // "approach" (lazysp's search, growth, direct command into the goal from a near state, or the
+  // way in through an approach where that collided); "start" for
   // any planner when the start already lay in the goal region (the path of no motion); else
   // empty.
   std::string found_by;

@@ -183,9 +183,14 @@ class SearchState {
   // here).
   std::optional<PathStep> connection(const JointVector& q, const JointVector& target,
                                      int& simulations) {
+    return connection(q, target, problem_.goal, simulations);
+  }
+  // The same, corrected to land in `land_in`.
+  std::optional<PathStep> connection(const JointVector& q, const JointVector& target,
+                                     const Goal& land_in, int& simulations) {
     simulations = 0;
     std::optional<PathStep> step =
-        direct_step_to(ctx_.sim, ws_, ctx_.command, q, target, &problem_.goal, &simulations);
+        direct_step_to(ctx_.sim, ws_, ctx_.command, q, target, &land_in, &simulations);
     if (!step) return std::nullopt;
     count_simulations(simulations, *step->outcome);
     if (!step->outcome->valid()) return std::nullopt;
