@@ -735,20 +735,26 @@ struct BlockedScene {
   Simulator sim;  // refers to `collision`
 };
 
-std::unique_ptr<BlockedScene> blocked_scene(const Fixture& f, const PlanningProblem& p,
-                                            const PlanResult& clear) {
-  SimulatorWorkspace ws(f.sim);
-  const Trajectory t = realize_path(f.sim, ws, p.start, clear.best_path, p.goal, kSampleEvery);
+// The fixture's scene with a ball of `radius` where the hand is at q.
+std::unique_ptr<BlockedScene> scene_with_ball(const Fixture& f, const JointVector& q,
+                                              double radius) {
   RobotData data(f.robot);
-  forward_kinematics(f.robot, data, t.q[t.q.size() / 2]);
+  forward_kinematics(f.robot, data, q);
   Environment env = f.env;
   Obstacle ball;
   ball.name = "unseen";
   ball.shape.type = ShapeType::Sphere;
-  ball.shape.radius = 0.04;
+  ball.shape.radius = radius;
   ball.pose.p = link_pose(f.robot, data, f.robot.tip_link()).p;
   env.obstacles.push_back(ball);
   return std::make_unique<BlockedScene>(f, env);
+}
+
+std::unique_ptr<BlockedScene> blocked_scene(const Fixture& f, const PlanningProblem& p,
+                                            const PlanResult& clear) {
+  SimulatorWorkspace ws(f.sim);
+  const Trajectory t = realize_path(f.sim, ws, p.start, clear.best_path, p.goal, kSampleEvery);
+  return scene_with_ball(f, t.q[t.q.size() / 2], 0.04);
 }
 
 // The problem a -> c, its first answer without the look (precheck 0) in the fixture's scene, and
@@ -860,16 +866,7 @@ PocketProblem pocket_problem(const Fixture& f, double along) {
   const double t0 = t.t.back() - open.best_path.back().outcome->duration;
   size_t k = 0;
   while (k + 1 < t.t.size() && t.t[k] < t0 + along * (t.t.back() - t0)) ++k;
-  RobotData data(f.robot);
-  forward_kinematics(f.robot, data, t.q[k]);
-  Environment env = f.env;
-  Obstacle ball;
-  ball.name = "pocket";
-  ball.shape.type = ShapeType::Sphere;
-  ball.shape.radius = 0.03;
-  ball.pose.p = link_pose(f.robot, data, f.robot.tip_link()).p;
-  env.obstacles.push_back(ball);
-  b.scene = std::make_unique<BlockedScene>(f, env);
+  b.scene = scene_with_ball(f, t.q[k], 0.03);
   return b;
 }
 

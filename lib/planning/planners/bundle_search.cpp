@@ -100,10 +100,12 @@ bool edge_ends_near(const PlanningContext& ctx, const JointVectorRef& q, double 
   // Without the index: every end state, as before the index existed.
   const BundleView& bundle = *ctx.bundle;
   const int n = bundle.dof();
+  scratch.clear();
   for (size_t e = 0; e < bundle.size(); ++e) {
-    if ((row(bundle.qf(e), n) - q).squaredNorm() <= radius * radius) return true;
+    const double d2 = (row(bundle.qf(e), n) - q).squaredNorm();
+    if (d2 <= radius * radius) scratch.emplace_back(static_cast<uint32_t>(e), d2);
   }
-  return false;
+  return !scratch.empty();
 }
 
 BundleSearch::BundleSearch(const BundleSolve& solve)

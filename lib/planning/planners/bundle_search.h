@@ -123,7 +123,8 @@ double bundle_planner_setup(const PlanningContext& context, const ParameterValue
                             const std::string& planner, bool perturbation);
 
 // Whether some bundle edge ends within `radius` of q: through the context's end-state index
-// when it has one (a k-d tree query), else by scanning every end state. `scratch` is reused.
+// when it has one (a k-d tree query), else by scanning every end state. `scratch` gets those
+// edges with their squared distances, by edge id (as EdgeIndex::within gives them).
 bool edge_ends_near(const PlanningContext& context, const JointVectorRef& q, double radius,
                     std::vector<std::pair<uint32_t, double>>& scratch);
 

@@ -34,17 +34,17 @@ constexpr double kChecksPerRollout = 400;
 // to a random command.
 constexpr size_t kGrowthTries = 8;
 // Approaches, the look backward from a joint goal (approach_to_goal): after this many direct
-// commands into the goal collided, the bundle edges ending nearest the goal, up to
-// kApproachCount of them within kApproachWidening x the neighbourhood, are shifted to end at the
-// goal. A direct command that collides then tries, from its real node, the nearest of the
-// approaches within kApproachReach, up to kApproachTries of them, whose edge and straight line
+// commands into the goal arrived invalid (collided, mostly), the bundle edges ending nearest the
+// goal, up to kApproachCount of them within kApproachWidening x the neighbourhood, are shifted to
+// end at the goal. A direct command that collides then tries, from its real node, the nearest of
+// the approaches within kApproachReach, up to kApproachTries of them, whose edge and straight line
 // look free (the line checked every kLineStep), landing within kApproachLanding of it. Chosen on
 // clutter-6571, 6572, 903, 8232, 9311 and shelf-6573 (60 runs each): after 2 collided commands
 // the approaches cost the easy problems 3-7 ms; after 5, landing within 0.05 rather than 0.02
 // rad (fewer corrections), the medians fell in five of the six. Looking at the approaches at
 // once (about 1,200 checked states for 64 free ones) cost a held-back problem 10 ms: each is
 // looked at when first considered. 512 approaches with no limit of tries checked 37 % more
-// states than without approaches over 15 sets; 128 and 8 tries, 11 % fewer (docs/performance.md).
+// states than without approaches over 15 sets; 128 and 8 tries, 9 % fewer (docs/performance.md).
 constexpr int kApproachAfter = 5;
 constexpr size_t kApproachCount = 128;
 constexpr size_t kApproachTries = 8;
@@ -231,14 +231,16 @@ class LazySpSearch {
     Look look = Look::Unknown;
   };
   std::vector<Approach> approaches_;  // look_for_approaches
-  int collided_connections_ = 0;      // direct commands into the goal that collided
+  int collided_connections_ = 0;      // direct commands into the goal that arrived invalid
   bool looked_for_approaches_ = false;
   bool goal_covered_ = true;
   std::unordered_set<uint64_t> tried_;  // (real node, edge) pairs simulated, valid or not
   // By the cell of a source state: edges whose stored samples, shifted there, collided (precheck).
   std::unordered_map<uint64_t, std::unordered_set<uint32_t>> blocked_;
-  JointVector probe_;                                // shifted_samples_free's scratch
-  std::vector<std::pair<double, uint32_t>> ranked_;  // grow_along_bundle's scratch
+  JointVector probe_;  // shifted_samples_free's and line_looks_free's scratch
+  // grow_along_bundle's scratch, and approach_from's (reached from grow_along_bundle's last use
+  // of it, through reached_by_growth)
+  std::vector<std::pair<double, uint32_t>> ranked_;
   std::vector<PathStep> commands_;  // the growth's commands, by LazySpNode::command
   Neighbours neighbours_;
   JointVector from_, step_, next_;  // expand's scratch
@@ -594,11 +596,11 @@ void LazySpSearch::look_for_approaches() {
   looked_for_approaches_ = true;
   const JointVector& goal = s_.problem().goal.q;
   if (!edge_ends_near(ctx_, goal, kApproachWidening * neighbourhood_, neighbours_)) return;
-  const size_t looks = std::min(kApproachCount, neighbours_.size());
-  std::partial_sort(neighbours_.begin(), neighbours_.begin() + looks, neighbours_.end(),
+  const size_t count = std::min(kApproachCount, neighbours_.size());
+  std::partial_sort(neighbours_.begin(), neighbours_.begin() + count, neighbours_.end(),
                     [](const auto& a, const auto& b) { return a.second < b.second; });
   const int n = bundle_.dof();
-  for (size_t k = 0; k < looks; ++k) {
+  for (size_t k = 0; k < count; ++k) {
     const uint32_t e = neighbours_[k].first;
     JointVector x = goal - (Eigen::Map<const Eigen::VectorXd>(bundle_.qf(e), n) -
                             Eigen::Map<const Eigen::VectorXd>(bundle_.q0(e), n));
@@ -607,10 +609,10 @@ void LazySpSearch::look_for_approaches() {
   }
 }
 
-// From real node v, whose direct command into the goal collided: the straight command to the
-// nearest approach whose line looks free, that approach's edge, then the direct command from
-// where it ends (within the landing tolerance plus the transfer's error of the goal). Each part
-// is simulated with every check; true when it reached the goal.
+// From real node v, whose direct command into the goal collided: the straight command to an
+// approach (approach_from), that approach's edge, then the direct command from where it ends
+// (within the landing tolerance plus the transfer's error of the goal). Each part is simulated with
+// every check; true when it reached the goal.
 bool LazySpSearch::approach_to_goal(int v) {
   const int a = approach_from(s_.node(v).q);
   if (a < 0) return false;
@@ -620,11 +622,13 @@ bool LazySpSearch::approach_to_goal(int v) {
   int simulations = 0;
   std::optional<PathStep> step = s_.connection(s_.node(v).q, landing.q, landing, simulations);
   if (!step) return false;
-  reached_by_connection(v, std::move(*step), "approach");
-  const int w = static_cast<int>(s_.nodes().size()) - 1;
+  if (reached_by_connection(v, std::move(*step), "approach")) return true;  // a wide goal
+  const int w = static_cast<int>(s_.nodes().size()) - 1;  // the landing (reached_by_connection)
   const uint32_t e = approaches_[a].edge;
   tried_.insert(key(w, e));
   const RolloutResult res = s_.simulate_from(s_.node(w).q, bundle_.command(e));
+  // An edge that fails from this landing stays offered: from another landing it may pass (the
+  // pocket test's answer comes in so; marked blocked, it is found by a connection instead).
   if (!res.valid()) return false;
   const int u = add_real(res, w, e, -1);
   if (s_.in_goal(s_.node(u).h)) {
