@@ -171,6 +171,12 @@ class LazySpSearch {
     return aims_at_configurations_ ? h <= set_.theta : h <= lazy_goal_radius_;
   }
   bool within_limits(const JointVector& q) const;
+  // Edge e's displacement qf - q0 (the transfer's step), into `out` (no allocation once sized).
+  void displacement(uint32_t e, JointVector& out) const {
+    const int n = bundle_.dof();
+    out = Eigen::Map<const Eigen::VectorXd>(bundle_.qf(e), n) -
+          Eigen::Map<const Eigen::VectorXd>(bundle_.q0(e), n);
+  }
   // The edges' stored link motions when the world limits the link's speed or acceleration
   // (edge_link_motion.h); null otherwise.
   static const EdgeLinkMotion* task_motions(const PlanningContext& ctx);
@@ -373,7 +379,6 @@ int LazySpSearch::expand(int p) {
   const int real = preds_[p].real;
   const NeighbourMemo::Span near = memo_.within(from_.data());
   successors_ += near.count;
-  const int n = bundle_.dof();
   const std::unordered_set<uint32_t>* blocked = blocked_from(preds_[p].cell);
   int goal = -1;
   double goal_g = std::numeric_limits<double>::infinity();
@@ -382,8 +387,7 @@ int LazySpSearch::expand(int p) {
     // From a real state, an edge simulated before is known: its real end is a source itself.
     if (real >= 0 && tried_.count(key(real, e))) continue;
     if (blocked && blocked->count(e)) continue;
-    step_ = Eigen::Map<const Eigen::VectorXd>(bundle_.qf(e), n) -
-            Eigen::Map<const Eigen::VectorXd>(bundle_.q0(e), n);
+    displacement(e, step_);
     next_ = from_ + step_;
     if (breaks_task(e) || !within_limits(next_) || !s_.within_tilt(next_)) continue;
     Predicted c;
@@ -524,14 +528,13 @@ bool LazySpSearch::grow_along_bundle(int from, const JointVector& x) {
   const NeighbourMemo::Span near = memo_.within(q.data());
   growth_work_ += static_cast<double>(near.count) / kSuccessorsPerRollout;
   const std::unordered_set<uint32_t>* blocked = blocked_from(source_cell);
-  const int n = bundle_.dof();
   ranked_.clear();
   for (size_t k = 0; k < near.count; ++k) {
     const uint32_t e = near.edges[k];
     if (tried_.count(key(from, e)) || breaks_task(e)) continue;
     if (blocked && blocked->count(e)) continue;
-    next_ = q + (Eigen::Map<const Eigen::VectorXd>(bundle_.qf(e), n) -
-                 Eigen::Map<const Eigen::VectorXd>(bundle_.q0(e), n));
+    displacement(e, step_);
+    next_ = q + step_;
     if (!within_limits(next_) || !s_.within_tilt(next_)) continue;
     ranked_.emplace_back((next_ - x).squaredNorm(), e);
   }
@@ -599,11 +602,10 @@ void LazySpSearch::look_for_approaches() {
   const size_t count = std::min(kApproachCount, neighbours_.size());
   std::partial_sort(neighbours_.begin(), neighbours_.begin() + count, neighbours_.end(),
                     [](const auto& a, const auto& b) { return a.second < b.second; });
-  const int n = bundle_.dof();
   for (size_t k = 0; k < count; ++k) {
     const uint32_t e = neighbours_[k].first;
-    JointVector x = goal - (Eigen::Map<const Eigen::VectorXd>(bundle_.qf(e), n) -
-                            Eigen::Map<const Eigen::VectorXd>(bundle_.q0(e), n));
+    displacement(e, step_);
+    JointVector x = goal - step_;
     if (breaks_task(e) || !within_limits(x) || !s_.within_tilt(x)) continue;
     approaches_.push_back({std::move(x), e});
   }
