@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 
+#include <algorithm>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -53,8 +54,18 @@ Neighbours scan(const BundleView& v, EdgePoint point, const double* q, double ra
   return out;
 }
 
+// The `count` nearest of a scan's results: nearest first, equal distances by id.
+Neighbours nearest_of(Neighbours all, size_t count) {
+  std::sort(all.begin(), all.end(), [](const auto& a, const auto& b) {
+    return a.second < b.second || (a.second == b.second && a.first < b.first);
+  });
+  all.resize(std::min(count, all.size()));
+  return all;
+}
+
 // Queries at edge states (where the radius is a neighbour's exact distance, the boundary
-// case), at random points and outside the points' box, for several radii.
+// case), at random points and outside the points' box, for several radii: within, any_within
+// and nearest answer as the scan.
 void expect_scan_results(const BundleView& v, const EdgeIndex& index) {
   std::mt19937_64 rng(3);
   std::uniform_real_distribution<double> u(-4, 4);
@@ -69,7 +80,13 @@ void expect_scan_results(const BundleView& v, const EdgeIndex& index) {
     if (!near.empty()) radii.push_back(std::sqrt(near[near.size() / 2].second));
     for (const double r : radii) {
       index.within(q.data(), r, found);
-      ASSERT_EQ(found, scan(v, index.point(), q.data(), r)) << "query " << i << " radius " << r;
+      const Neighbours expected = scan(v, index.point(), q.data(), r);
+      ASSERT_EQ(found, expected) << "query " << i << " radius " << r;
+      ASSERT_EQ(index.any_within(q.data(), r), !expected.empty()) << "query " << i;
+      for (const size_t count : {1, 8, 128}) {
+        index.nearest(q.data(), count, r, found);
+        ASSERT_EQ(found, nearest_of(expected, count)) << "query " << i << " count " << count;
+      }
     }
   }
 }
@@ -134,6 +151,11 @@ TEST(EdgeIndex, TinyAndEmptyBundles) {
     index.within(q.data(), 100, found);
     EXPECT_EQ(found, scan(v, EdgePoint::Start, q.data(), 100)) << n << " edges";
     EXPECT_EQ(found.size(), n);
+    EXPECT_EQ(index.any_within(q.data(), 100), n > 0);
+    index.nearest(q.data(), 4, 100, found);
+    EXPECT_EQ(found, nearest_of(scan(v, EdgePoint::Start, q.data(), 100), 4)) << n << " edges";
+    index.nearest(q.data(), 0, 100, found);
+    EXPECT_TRUE(found.empty());
   }
 }
 

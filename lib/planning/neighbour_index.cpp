@@ -111,6 +111,9 @@ class TreeBuilder {
 
 // The search's state: the query, the squared radius, and the distance from q to the current
 // node's cell per dimension (the incremental bound of Arya and Mount, as nanoflann does).
+// `out` null: the search only asks whether some point is within, and stops at the first.
+// `nearest` > 0: `out` is a max-heap of the nearest so far, and once it is full the radius
+// shrinks to its farthest.
 struct Search {
   const KdTreeArrays& tree;
   const double* rows;
@@ -119,9 +122,11 @@ struct Search {
   const double* q;
   double r2, prune;  // prune: r2 with a margin, so that rounding in the bound never drops a point
   std::array<double, kMaxDof> cell{};
-  std::vector<std::pair<uint32_t, double>>& out;
+  std::vector<std::pair<uint32_t, double>>* out;
+  size_t nearest = 0;
+  bool found = false;
 
-  void leaf(const KdNode& n) const {
+  void leaf(const KdNode& n) {
     for (uint32_t i = n.first; i < n.second; ++i) {
       const double* p = rows + size_t{leaf_ordered ? i : tree.order[i]} * dof;
       double d = 0;
@@ -129,8 +134,36 @@ struct Search {
         const double diff = q[k] - p[k];
         d += diff * diff;
       }
-      if (d < r2) out.emplace_back(tree.order[i], d);
+      // Full of nearest ones, the radius is the farthest kept: a tie may still replace it by id.
+      const bool tie = nearest > 0 && out->size() == nearest && d == r2;
+      if (d >= r2 && !tie) continue;
+      found = true;
+      if (out == nullptr) return;
+      if (nearest == 0) {
+        out->emplace_back(tree.order[i], d);
+      } else {
+        keep_nearest(tree.order[i], d);
+      }
     }
+  }
+
+  void keep_nearest(uint32_t id, double d) {
+    if (out->size() == nearest) {
+      if (!nearer({id, d}, out->front())) return;
+      std::pop_heap(out->begin(), out->end(), nearer);
+      out->pop_back();
+    }
+    out->emplace_back(id, d);
+    std::push_heap(out->begin(), out->end(), nearer);
+    if (out->size() == nearest) {
+      r2 = out->front().second;
+      prune = r2 * (1 + 1e-9);
+    }
+  }
+
+  // Nearer, ties by id: the order of nearest()'s result.
+  static bool nearer(const std::pair<uint32_t, double>& a, const std::pair<uint32_t, double>& b) {
+    return a.second < b.second || (a.second == b.second && a.first < b.first);
   }
 
   void visit(uint32_t node, double bound) {
@@ -140,6 +173,7 @@ struct Search {
     const bool left_first = to_low + to_high < 0;
     const double far_gap = left_first ? to_high * to_high : to_low * to_low;
     visit(left_first ? n.first : n.second, bound);
+    if (found && out == nullptr) return;
     const double saved = cell[n.dim];
     const double far_bound = bound + far_gap - saved;
     if (far_bound <= prune) {
@@ -266,15 +300,14 @@ EdgeIndex::~EdgeIndex() = default;
 EdgePoint EdgeIndex::point() const { return impl_->point; }
 const KdTreeArrays& EdgeIndex::arrays() const { return impl_->arrays; }
 
-void EdgeIndex::within(const double* q, double radius,
-                       std::vector<std::pair<uint32_t, double>>& out) const {
-  out.clear();
+bool EdgeIndex::search(const double* q, double radius, std::vector<std::pair<uint32_t, double>>* out,
+                       size_t nearest) const {
   const Impl& m = *impl_;
-  if (m.rows == nullptr) return;
+  if (m.rows == nullptr) return false;
   const double r2 = radius * radius;
   const bool leaf_ordered = !m.leaf_rows.empty();
   const double* rows = leaf_ordered ? m.leaf_rows.data() : m.rows;
-  Search s{m.arrays, rows, leaf_ordered, m.dof, q, r2, r2 * (1 + 1e-9), {}, out};
+  Search s{m.arrays, rows, leaf_ordered, m.dof, q, r2, r2 * (1 + 1e-9), {}, out, nearest};
   double bound = 0;
   for (int d = 0; d < m.dof; ++d) {
     const double gap = std::max({m.arrays.lower[d] - q[d], q[d] - m.arrays.upper[d], 0.0});
@@ -282,7 +315,26 @@ void EdgeIndex::within(const double* q, double radius,
     bound += s.cell[d];
   }
   if (bound <= s.prune) s.visit(0, bound);
+  return s.found;
+}
+
+void EdgeIndex::within(const double* q, double radius,
+                       std::vector<std::pair<uint32_t, double>>& out) const {
+  out.clear();
+  search(q, radius, &out);
   std::sort(out.begin(), out.end());
+}
+
+bool EdgeIndex::any_within(const double* q, double radius) const {
+  return search(q, radius, nullptr);
+}
+
+void EdgeIndex::nearest(const double* q, size_t count, double radius,
+                        std::vector<std::pair<uint32_t, double>>& out) const {
+  out.clear();
+  if (count == 0) return;
+  search(q, radius, &out, count);
+  std::sort_heap(out.begin(), out.end(), Search::nearer);
 }
 
 }  // namespace lazyboe

@@ -65,8 +65,18 @@ class EdgeIndex {
   // space) of q, with their squared distances, sorted by edge id so results do not depend on
   // the tree's shape. `out` is reused (no allocation once it has grown).
   void within(const double* q, double radius, std::vector<std::pair<uint32_t, double>>& out) const;
+  // Whether some edge's start (end) lies within `radius` of q: the search stops at the first.
+  bool any_within(const double* q, double radius) const;
+  // The `count` edges whose start (end) lies nearest q within `radius`, nearest first (equal
+  // distances by edge id), with their squared distances; `out` is reused.
+  void nearest(const double* q, size_t count, double radius,
+               std::vector<std::pair<uint32_t, double>>& out) const;
 
  private:
+  // Fills `out` when it is not null (with the `nearest` nearest only, as a max-heap, when that
+  // is not 0); returns whether some point was found.
+  bool search(const double* q, double radius, std::vector<std::pair<uint32_t, double>>* out,
+              size_t nearest = 0) const;
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

@@ -108,6 +108,24 @@ bool edge_ends_near(const PlanningContext& ctx, const JointVectorRef& q, double 
   return !scratch.empty();
 }
 
+bool some_edge_ends_near(const PlanningContext& ctx, const JointVectorRef& q, double radius) {
+  if (ctx.end_index) return ctx.end_index->any_within(q.data(), radius);
+  std::vector<std::pair<uint32_t, double>> scratch;
+  return edge_ends_near(ctx, q, radius, scratch);
+}
+
+void edges_ending_nearest(const PlanningContext& ctx, const JointVectorRef& q, size_t count,
+                          double radius, std::vector<std::pair<uint32_t, double>>& scratch) {
+  if (ctx.end_index) return ctx.end_index->nearest(q.data(), count, radius, scratch);
+  edge_ends_near(ctx, q, radius, scratch);
+  const auto nearer = [](const auto& a, const auto& b) {
+    return a.second < b.second || (a.second == b.second && a.first < b.first);
+  };
+  count = std::min(count, scratch.size());
+  std::partial_sort(scratch.begin(), scratch.begin() + count, scratch.end(), nearer);
+  scratch.resize(count);
+}
+
 BundleSearch::BundleSearch(const BundleSolve& solve)
     : ctx_(solve.context),
       bundle_(*solve.context.bundle),
@@ -128,8 +146,8 @@ PlanResult BundleSearch::run() {
   root.q = s_.problem().start;
   root.h = s_.heuristic(root.q);
   push(s_.add(root));
+  if (!covered()) return s_.result();
   Neighbours neighbours;
-  if (!covered(neighbours)) return s_.result();
   while (!s_.should_stop()) {
     const int v = pop();
     if (v < 0) break;
@@ -148,9 +166,8 @@ PlanResult BundleSearch::run() {
 }
 
 // Coverage: a start or goal the bundle cannot reach is a clear failure, not a timeout.
-bool BundleSearch::covered(Neighbours& neighbours) {
-  ctx_.index->within(s_.problem().start.data(), theta_, neighbours);
-  if (neighbours.empty()) {
+bool BundleSearch::covered() {
+  if (!ctx_.index->any_within(s_.problem().start.data(), theta_)) {
     s_.result().failure = "no bundle edge starts within theta = " + std::to_string(theta_) +
                           " rad of the start: it is outside the bundle's coverage (" +
                           coverage_hint(ctx_, s_.problem().start, false) +
@@ -161,7 +178,7 @@ bool BundleSearch::covered(Neighbours& neighbours) {
   const Goal& goal = s_.problem().goal;
   if (goal.kind != Goal::Kind::Joint) return true;
   const double reach = theta_ + goal.tolerance;
-  if (edge_ends_near(ctx_, goal.q, reach, neighbours)) return true;
+  if (some_edge_ends_near(ctx_, goal.q, reach)) return true;
   s_.result().failure = "no bundle edge ends within theta + tolerance = " + std::to_string(reach) +
                         " rad of the goal: it is outside the bundle's coverage (" +
                         coverage_hint(ctx_, goal.q, true) +

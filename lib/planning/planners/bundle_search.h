@@ -94,7 +94,7 @@ class BundleSearch {
 
  private:
   static uint64_t key(int v, uint32_t e) { return (static_cast<uint64_t>(v) << 32) | e; }
-  bool covered(Neighbours& neighbours);
+  bool covered();
   int pop();
   bool skip(int v);
   void expand(int v, Neighbours& neighbours);
@@ -127,6 +127,13 @@ double bundle_planner_setup(const PlanningContext& context, const ParameterValue
 // edges with their squared distances, by edge id (as EdgeIndex::within gives them).
 bool edge_ends_near(const PlanningContext& context, const JointVectorRef& q, double radius,
                     std::vector<std::pair<uint32_t, double>>& scratch);
+// The same question when the edges are not needed (a coverage check): the index's search stops
+// at the first edge end it finds, rather than listing and sorting thousands.
+bool some_edge_ends_near(const PlanningContext& context, const JointVectorRef& q, double radius);
+// The `count` edges ending nearest q within `radius`, nearest first (equal distances by edge id),
+// into `scratch` with their squared distances.
+void edges_ending_nearest(const PlanningContext& context, const JointVectorRef& q, size_t count,
+                          double radius, std::vector<std::pair<uint32_t, double>>& scratch);
 
 // The base of the bundle planners (BoE, LazyBoE, lazysp): setup checks that the context has a
 // bundle and its index (and the perturbation analysis, when the planner's needs say so),

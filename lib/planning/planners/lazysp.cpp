@@ -277,7 +277,7 @@ PlanResult LazySpSearch::run() {
   // beyond the lazy search, and only the growth can reach it.
   const Goal& goal = s_.problem().goal;
   if (goal.kind == Goal::Kind::Joint)
-    goal_covered_ = edge_ends_near(ctx_, goal.q, neighbourhood_ + lazy_goal_radius_, neighbours_);
+    goal_covered_ = some_edge_ends_near(ctx_, goal.q, neighbourhood_ + lazy_goal_radius_);
   while (!s_.should_stop()) {
     if (lazy_turn()) {
       lazy_round();
@@ -598,12 +598,9 @@ bool LazySpSearch::reached_by_connection(int v, PathStep step, const char* by) {
 void LazySpSearch::look_for_approaches() {
   looked_for_approaches_ = true;
   const JointVector& goal = s_.problem().goal.q;
-  if (!edge_ends_near(ctx_, goal, kApproachWidening * neighbourhood_, neighbours_)) return;
-  const size_t count = std::min(kApproachCount, neighbours_.size());
-  std::partial_sort(neighbours_.begin(), neighbours_.begin() + count, neighbours_.end(),
-                    [](const auto& a, const auto& b) { return a.second < b.second; });
-  for (size_t k = 0; k < count; ++k) {
-    const uint32_t e = neighbours_[k].first;
+  edges_ending_nearest(ctx_, goal, kApproachCount, kApproachWidening * neighbourhood_,
+                       neighbours_);
+  for (const auto& [e, distance] : neighbours_) {
     displacement(e, step_);
     JointVector x = goal - step_;
     if (breaks_task(e) || !within_limits(x) || !s_.within_tilt(x)) continue;
