@@ -393,6 +393,20 @@ int start_rollout(const Simulator& sim, SimulatorWorkspace& ws, const Trajectory
   return 0;
 }
 
+// A rollout's end at rest: the last motion collision-checked, then its last sample and tick.
+RolloutStatus end_at_rest(const Simulator& sim, SimulatorWorkspace& ws, const TickState& s,
+                          const JointVector& v_cmd, const TrajectorySamples& samples,
+                          int sample_every, int tick, RolloutResult& result) {
+  if (s.moved > 0) {
+    const RolloutStatus c = collision_status(sim, ws, s.q, result.collision_checks);
+    if (c != RolloutStatus::Valid) return c;
+  }
+  if (samples.q && (sample_every <= 0 || tick % sample_every != 0))
+    push_sample(samples, s.q, s.dq);
+  if (samples.ticks) push_tick(*samples.ticks, s.q, s.dq, s.ddq_prev, v_cmd);
+  return RolloutStatus::Valid;
+}
+
 }  // namespace
 
 RolloutResult simulate(const Simulator& sim, SimulatorWorkspace& ws, const JointVectorRef& q0_in,
@@ -443,17 +457,11 @@ RolloutResult simulate(const Simulator& sim, SimulatorWorkspace& ws, const Joint
       return finish(RolloutStatus::TorqueRateLimit, tick);
     s.tau_prev = tau;
 
-    // Stop once at rest after the command (the last motion collision-checked).
+    // Stop once at rest after the command.
     if (t >= profile.duration &&
         at_rest(sim, rd, dq, s.ddq_prev, tau, ddq_step_max, tau_rate_max) &&
         end_effector.can_rest()) {
-      if (s.moved > 0) {
-        const RolloutStatus c = collision_status(sim, ws, q, result.collision_checks);
-        if (c != RolloutStatus::Valid) return finish(c, tick);
-      }
-      if (samples.q && (sample_every <= 0 || tick % sample_every != 0)) push_sample(samples, q, dq);
-      if (samples.ticks) push_tick(*samples.ticks, q, dq, s.ddq_prev, v_cmd);
-      return finish(RolloutStatus::Valid, tick);
+      return finish(end_at_rest(sim, ws, s, v_cmd, samples, sample_every, tick, result), tick);
     }
 
     if (samples.ticks) push_tick(*samples.ticks, q, dq, s.ddq_prev, v_cmd);
