@@ -300,8 +300,8 @@ EdgeIndex::~EdgeIndex() = default;
 EdgePoint EdgeIndex::point() const { return impl_->point; }
 const KdTreeArrays& EdgeIndex::arrays() const { return impl_->arrays; }
 
-bool EdgeIndex::search(const double* q, double radius, std::vector<std::pair<uint32_t, double>>* out,
-                       size_t nearest) const {
+bool EdgeIndex::search(const double* q, double radius,
+                       std::vector<std::pair<uint32_t, double>>* out, size_t nearest) const {
   const Impl& m = *impl_;
   if (m.rows == nullptr) return false;
   const double r2 = radius * radius;

@@ -401,8 +401,7 @@ RolloutStatus end_at_rest(const Simulator& sim, SimulatorWorkspace& ws, const Ti
     const RolloutStatus c = collision_status(sim, ws, s.q, result.collision_checks);
     if (c != RolloutStatus::Valid) return c;
   }
-  if (samples.q && (sample_every <= 0 || tick % sample_every != 0))
-    push_sample(samples, s.q, s.dq);
+  if (samples.q && (sample_every <= 0 || tick % sample_every != 0)) push_sample(samples, s.q, s.dq);
   if (samples.ticks) push_tick(*samples.ticks, s.q, s.dq, s.ddq_prev, v_cmd);
   return RolloutStatus::Valid;
 }
