@@ -26,6 +26,7 @@
 #include "lazyboe/bundle/bundle_view.h"
 #include "lazyboe/common/error.h"
 #include "lazyboe/planning/neighbour_index.h"
+#include "lazyboe/planning/planners/bundle_search.h"
 #include "lazyboe/planning/planning_session.h"
 #include "lazyboe/planning/problem.h"
 #include "lazyboe/planning/registry.h"
@@ -543,6 +544,41 @@ TEST(LazySp, TheEndStateIndexAgreesWithAScan) {
       EXPECT_EQ(ids, scanned) << "radius " << radius;
     }
   }
+}
+
+// Without the end-state index (a context that has none), the coverage checks scan every end
+// state and answer exactly as the index does: the same edges within, whether there is one, and
+// the same nearest ones in the same order, also at a radius that is an edge end's exact distance.
+TEST(LazySp, CoverageWithoutTheEndIndexAnswersAsWithIt) {
+  const Fixture& f = fixture();
+  const PlanningContext indexed = session_context(f, f.sim);
+  PlanningContext scanning = session_context(f, f.sim);
+  scanning.end_index = nullptr;
+  std::vector<std::pair<uint32_t, double>> by_index, by_scan;
+  std::vector<JointVector> queries = {f.a, f.b, f.c};
+  for (const size_t e : {size_t{0}, f.view.size() / 2})
+    queries.push_back(Eigen::Map<const Eigen::VectorXd>(f.view.qf(e), f.robot.dof));
+  size_t nonempty = 0;
+  for (const JointVector& q : queries) {
+    std::vector<double> radii = {1e-9, 0.1, 0.3, 0.75};
+    edge_ends_near(indexed, q, 0.75, by_index);
+    if (!by_index.empty()) radii.push_back(std::sqrt(by_index[by_index.size() / 2].second));
+    for (const double radius : radii) {
+      const bool found = edge_ends_near(indexed, q, radius, by_index);
+      EXPECT_EQ(edge_ends_near(scanning, q, radius, by_scan), found);
+      EXPECT_EQ(by_scan, by_index) << "radius " << radius;
+      EXPECT_EQ(some_edge_ends_near(indexed, q, radius), found);
+      EXPECT_EQ(some_edge_ends_near(scanning, q, radius), found);
+      nonempty += found;
+      for (const size_t count : {1, 8, 64}) {
+        edges_ending_nearest(indexed, q, count, radius, by_index);
+        edges_ending_nearest(scanning, q, count, radius, by_scan);
+        EXPECT_EQ(by_scan, by_index) << "radius " << radius << " count " << count;
+        EXPECT_LE(by_index.size(), count);
+      }
+    }
+  }
+  EXPECT_GT(nonempty, 5u) << "the queries found too few edge ends to compare";
 }
 
 // A lazysp result passes realize_path on `sim`, the independent re-validation, and its

@@ -109,11 +109,16 @@ class TreeBuilder {
   std::vector<Key> keys_;
 };
 
+// What a search gives: every point within the radius, whether there is one (stopping at the
+// first), or the `nearest` nearest within it. A template parameter, so that the radius query the
+// planners run thousands of times a solve tests nothing in its inner loop that it does not need.
+enum class SearchMode { Within, Any, Nearest };
+
 // The search's state: the query, the squared radius, and the distance from q to the current
 // node's cell per dimension (the incremental bound of Arya and Mount, as nanoflann does).
-// `out` null: the search only asks whether some point is within, and stops at the first.
-// `nearest` > 0: `out` is a max-heap of the nearest so far, and once it is full the radius
-// shrinks to its farthest.
+// Nearest: `out` is a max-heap of the nearest so far, and once it is full the radius shrinks to
+// its farthest.
+template <SearchMode Mode>
 struct Search {
   const KdTreeArrays& tree;
   const double* rows;
@@ -122,48 +127,39 @@ struct Search {
   const double* q;
   double r2, prune;  // prune: r2 with a margin, so that rounding in the bound never drops a point
   std::array<double, kMaxDof> cell{};
-  std::vector<std::pair<uint32_t, double>>* out;
+  std::vector<std::pair<uint32_t, double>>* out;  // null for SearchMode::Any
   size_t nearest = 0;
   bool found = false;
 
   void leaf(const KdNode& n) {
     for (uint32_t i = n.first; i < n.second; ++i) {
-      const double* p = rows + size_t{leaf_ordered ? i : tree.order[i]} * dof;
-      double d = 0;
-      for (int k = 0; k < dof; ++k) {
-        const double diff = q[k] - p[k];
-        d += diff * diff;
-      }
-      // Full of nearest ones, the radius is the farthest kept: a tie may still replace it by id.
-      const bool tie = nearest > 0 && out->size() == nearest && d == r2;
-      if (d >= r2 && !tie) continue;
-      found = true;
-      if (out == nullptr) return;
-      if (nearest == 0) {
-        out->emplace_back(tree.order[i], d);
-      } else {
+      const double d =
+          squared_distance(q, rows + size_t{leaf_ordered ? i : tree.order[i]} * dof, dof);
+      if constexpr (Mode == SearchMode::Nearest) {
+        // Full of nearest ones, the radius is the farthest kept: a tie may still replace it by id.
+        if (d > r2 || (d == r2 && out->size() < nearest)) continue;
         keep_nearest(tree.order[i], d);
+      } else {
+        if (d >= r2) continue;
+        found = true;
+        if constexpr (Mode == SearchMode::Any) return;
+        out->emplace_back(tree.order[i], d);
       }
     }
   }
 
   void keep_nearest(uint32_t id, double d) {
     if (out->size() == nearest) {
-      if (!nearer({id, d}, out->front())) return;
-      std::pop_heap(out->begin(), out->end(), nearer);
+      if (!nearer_edge({id, d}, out->front())) return;
+      std::pop_heap(out->begin(), out->end(), nearer_edge);
       out->pop_back();
     }
     out->emplace_back(id, d);
-    std::push_heap(out->begin(), out->end(), nearer);
+    std::push_heap(out->begin(), out->end(), nearer_edge);
     if (out->size() == nearest) {
       r2 = out->front().second;
       prune = r2 * (1 + 1e-9);
     }
-  }
-
-  // Nearer, ties by id: the order of nearest()'s result.
-  static bool nearer(const std::pair<uint32_t, double>& a, const std::pair<uint32_t, double>& b) {
-    return a.second < b.second || (a.second == b.second && a.first < b.first);
   }
 
   void visit(uint32_t node, double bound) {
@@ -173,7 +169,9 @@ struct Search {
     const bool left_first = to_low + to_high < 0;
     const double far_gap = left_first ? to_high * to_high : to_low * to_low;
     visit(left_first ? n.first : n.second, bound);
-    if (found && out == nullptr) return;
+    if constexpr (Mode == SearchMode::Any) {
+      if (found) return;
+    }
     const double saved = cell[n.dim];
     const double far_bound = bound + far_gap - saved;
     if (far_bound <= prune) {
@@ -181,6 +179,19 @@ struct Search {
       visit(left_first ? n.second : n.first, far_bound);
       cell[n.dim] = saved;
     }
+  }
+
+  // Searches from the root, whose cell is the points' bounding box; returns whether a point
+  // was found (for SearchMode::Any).
+  bool run() {
+    double bound = 0;
+    for (int d = 0; d < dof; ++d) {
+      const double gap = std::max({tree.lower[d] - q[d], q[d] - tree.upper[d], 0.0});
+      cell[d] = gap * gap;
+      bound += cell[d];
+    }
+    if (bound <= prune) visit(0, bound);
+    return found;
   }
 };
 
@@ -304,18 +315,20 @@ bool EdgeIndex::search(const double* q, double radius,
                        std::vector<std::pair<uint32_t, double>>* out, size_t nearest) const {
   const Impl& m = *impl_;
   if (m.rows == nullptr) return false;
-  const double r2 = radius * radius;
+  const double r2 = radius * radius, prune = r2 * (1 + 1e-9);
   const bool leaf_ordered = !m.leaf_rows.empty();
   const double* rows = leaf_ordered ? m.leaf_rows.data() : m.rows;
-  Search s{m.arrays, rows, leaf_ordered, m.dof, q, r2, r2 * (1 + 1e-9), {}, out, nearest};
-  double bound = 0;
-  for (int d = 0; d < m.dof; ++d) {
-    const double gap = std::max({m.arrays.lower[d] - q[d], q[d] - m.arrays.upper[d], 0.0});
-    s.cell[d] = gap * gap;
-    bound += s.cell[d];
+  if (out == nullptr) {
+    return Search<SearchMode::Any>{m.arrays, rows, leaf_ordered, m.dof, q, r2, prune, {}, out}
+        .run();
   }
-  if (bound <= s.prune) s.visit(0, bound);
-  return s.found;
+  if (nearest == 0) {
+    return Search<SearchMode::Within>{m.arrays, rows, leaf_ordered, m.dof, q, r2, prune, {}, out}
+        .run();
+  }
+  return Search<SearchMode::Nearest>{m.arrays, rows,  leaf_ordered, m.dof, q,
+                                     r2,       prune, {},           out,   nearest}
+      .run();
 }
 
 void EdgeIndex::within(const double* q, double radius,
@@ -334,7 +347,7 @@ void EdgeIndex::nearest(const double* q, size_t count, double radius,
   out.clear();
   if (count == 0) return;
   search(q, radius, &out, count);
-  std::sort_heap(out.begin(), out.end(), Search::nearer);
+  std::sort_heap(out.begin(), out.end(), nearer_edge);
 }
 
 }  // namespace lazyboe

@@ -12,6 +12,25 @@
 
 namespace lazyboe {
 
+// The squared Euclidean distance between two joint vectors, summed in joint order: what the
+// index calls the distance (a point is within a radius when this is strictly below its square),
+// for scans that must answer exactly as the index does.
+inline double squared_distance(const double* a, const double* b, int dof) {
+  double d = 0;
+  for (int k = 0; k < dof; ++k) {
+    const double diff = a[k] - b[k];
+    d += diff * diff;
+  }
+  return d;
+}
+
+// Edges with their squared distances, nearer first and equal distances by edge id: the order of
+// EdgeIndex::nearest's result.
+inline bool nearer_edge(const std::pair<uint32_t, double>& a,
+                        const std::pair<uint32_t, double>& b) {
+  return a.second < b.second || (a.second == b.second && a.first < b.first);
+}
+
 // Which state of every edge an index holds.
 enum class EdgePoint { Start, End };
 

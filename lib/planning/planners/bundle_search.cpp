@@ -97,13 +97,13 @@ bool edge_ends_near(const PlanningContext& ctx, const JointVectorRef& q, double 
     ctx.end_index->within(q.data(), radius, scratch);
     return !scratch.empty();
   }
-  // Without the index: every end state, as before the index existed.
+  // Without the index: every end state, by the index's own distance and boundary.
   const BundleView& bundle = *ctx.bundle;
   const int n = bundle.dof();
   scratch.clear();
   for (size_t e = 0; e < bundle.size(); ++e) {
-    const double d2 = (row(bundle.qf(e), n) - q).squaredNorm();
-    if (d2 <= radius * radius) scratch.emplace_back(static_cast<uint32_t>(e), d2);
+    const double d2 = squared_distance(q.data(), bundle.qf(e), n);
+    if (d2 < radius * radius) scratch.emplace_back(static_cast<uint32_t>(e), d2);
   }
   return !scratch.empty();
 }
@@ -118,11 +118,8 @@ void edges_ending_nearest(const PlanningContext& ctx, const JointVectorRef& q, s
                           double radius, std::vector<std::pair<uint32_t, double>>& scratch) {
   if (ctx.end_index) return ctx.end_index->nearest(q.data(), count, radius, scratch);
   edge_ends_near(ctx, q, radius, scratch);
-  const auto nearer = [](const auto& a, const auto& b) {
-    return a.second < b.second || (a.second == b.second && a.first < b.first);
-  };
   count = std::min(count, scratch.size());
-  std::partial_sort(scratch.begin(), scratch.begin() + count, scratch.end(), nearer);
+  std::partial_sort(scratch.begin(), scratch.begin() + count, scratch.end(), nearer_edge);
   scratch.resize(count);
 }
 
