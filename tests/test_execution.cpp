@@ -11,6 +11,8 @@
 // ticks simulated.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -410,17 +412,15 @@ PathStep free_straight_step(const PlanningProblem& p) {
   return *straight;
 }
 
-// A ball at the hand somewhere along the straight motion, clear of the start and the goal.
-bool block_straight_motion(const PlanningProblem& p, const PathStep& straight, Obstructed& out) {
+// A ball at the hand somewhere along a motion (state_at(fraction)), clear of the start and the
+// goal.
+bool block_motion(const PlanningProblem& p, const std::function<JointVector(double)>& state_at,
+                  Obstructed& out) {
   const Fixture& f = fixture();
-  const int n = f.robot.dof;
-  const size_t rows = straight.outcome_rows.size() / (4 * n);
   for (double at : {0.5, 0.4, 0.6, 0.3, 0.7}) {
     for (double radius : {0.03, 0.02, 0.01}) {
       RobotData data(f.robot);
-      const size_t k = static_cast<size_t>(at * rows);
-      forward_kinematics(f.robot, data,
-                         Eigen::Map<const Eigen::VectorXd>(&straight.outcome_rows[k * 4 * n], n));
+      forward_kinematics(f.robot, data, state_at(at));
       out.env = f.env;
       Obstacle ball;
       ball.name = "on-the-straight-line";
@@ -437,6 +437,33 @@ bool block_straight_motion(const PlanningProblem& p, const PathStep& straight, O
     }
   }
   return false;
+}
+
+// A ball on the straight command's simulated motion.
+bool block_straight_motion(const PlanningProblem& p, const PathStep& straight, Obstructed& out) {
+  const int n = fixture().robot.dof;
+  const size_t rows = straight.outcome_rows.size() / (4 * n);
+  return block_motion(
+      p,
+      [&](double at) {
+        const size_t k = static_cast<size_t>(at * rows);
+        return JointVector(Eigen::Map<const Eigen::VectorXd>(&straight.outcome_rows[k * 4 * n], n));
+      },
+      out);
+}
+
+// A ball on the joint-space line from the start to the goal, at one of the states the look
+// checks (line_looks_free).
+bool block_line(const PlanningProblem& p, Obstructed& out) {
+  const JointVector span = p.goal.q - p.start;
+  const int steps = static_cast<int>(std::ceil(span.norm() / kLineLookStep));
+  return block_motion(
+      p,
+      [&](double at) {
+        const int k = static_cast<int>(at * steps);
+        return JointVector(p.start + span * (static_cast<double>(k) / steps));
+      },
+      out);
 }
 
 // The bundle planners try the straight command first: where it is free it is the answer (one
@@ -486,6 +513,57 @@ TEST(Execution, ABlockedStraightCommandIsNotTheAnswer) {
       EXPECT_NO_THROW(realize_path(*o.sim, ws, p.start, r.best_path, p.goal, 10));
       EXPECT_NE(r.best_path[0].bundle_edge, -1);
     }
+  }
+}
+
+// The look at a direct command's joint-space line: every kLineLookStep, the end included, on a
+// free line; stopped at a state an obstacle on the line blocks.
+TEST(Execution, TheLookAtALineFindsWhatBlocksIt) {
+  const Fixture& f = fixture();
+  const PlanningProblem p = problem_to(f.a, f.b);
+  const uint64_t steps = static_cast<uint64_t>(std::ceil((f.b - f.a).norm() / kLineLookStep));
+  ASSERT_GT(steps, 4u);
+  SimulatorWorkspace ws(f.sim);
+  uint64_t checks = 0;
+  EXPECT_TRUE(line_looks_free(f.sim, ws, f.a, f.b, &checks));
+  EXPECT_EQ(checks, steps);
+  Obstructed o;
+  ASSERT_TRUE(block_line(p, o)) << "no ball on the line clears the start and the goal";
+  SimulatorWorkspace blocked(*o.sim);
+  checks = 0;
+  EXPECT_FALSE(line_looks_free(*o.sim, blocked, f.a, f.b, &checks));
+  EXPECT_GT(checks, 0u);
+  EXPECT_LT(checks, steps);
+}
+
+// Where the line to the goal is blocked (a path of several edges, as long_path's), the shortcut
+// pass leaves out the candidates whose line is blocked without simulating them (fewer simulations
+// than without the look), and both trajectories pass re-simulation and the independent checker in
+// the scene.
+TEST(Execution, TheShortcutPassLooksBeforeItSimulates) {
+  const Fixture& f = fixture();
+  const PlanningProblem p = problem_to(f.a, f.c);
+  Obstructed o;
+  ASSERT_TRUE(block_line(p, o)) << "no ball on the line clears the start and the goal";
+  const PlanningContext context = bundle_context(*o.sim, f.view, f.index);
+  SimulatorWorkspace ws(*o.sim);
+  const PlanResult r = plan(context, ws, "boe", searching("boe"), p);
+  ASSERT_TRUE(r.success) << r.failure;
+  ASSERT_GE(r.best_path.size(), 2u);
+  ExecutionOptions on = options(true, true), off = on;
+  off.look = false;
+  const ExecutableTrajectory with_look =
+      make_executable(*o.sim, ws, p.start, r.best_path, p.goal, on, 1);
+  const ExecutableTrajectory without =
+      make_executable(*o.sim, ws, p.start, r.best_path, p.goal, off, 1);
+  EXPECT_GE(with_look.stats.looked_blocked, 1);
+  EXPECT_EQ(without.stats.looked_blocked, 0);
+  EXPECT_LT(with_look.stats.simulations, without.stats.simulations);
+  for (const ExecutableTrajectory* e : {&with_look, &without}) {
+    EXPECT_FALSE(e->stats.fell_back);
+    EXPECT_EQ(resimulate_segments(*o.sim, *e, p.start), "");
+    EXPECT_EQ(checker_verdict(*o.sim, e->trajectory), "");
+    expect_at_rest_ends(*o.sim, *e, p);
   }
 }
 

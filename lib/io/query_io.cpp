@@ -263,17 +263,12 @@ nlohmann::json rows_json(const std::vector<JointVector>& rows) {
 }
 
 nlohmann::json execution_json(const ExecutionStats& e) {
-  return {{"raw_steps", e.raw_steps},
-          {"steps", e.steps},
-          {"shortcuts", e.shortcuts},
-          {"junctions", e.junctions},
-          {"blends_kept", e.blends_kept},
-          {"simulations", e.simulations},
-          {"simulated_ticks", e.simulated_ticks},
-          {"resumed_ticks", e.resumed_ticks},
-          {"seconds", e.seconds},
-          {"raw_seconds", e.raw_seconds},
-          {"fell_back", e.fell_back}};
+  return {{"raw_steps", e.raw_steps},         {"steps", e.steps},
+          {"shortcuts", e.shortcuts},         {"looked_blocked", e.looked_blocked},
+          {"junctions", e.junctions},         {"blends_kept", e.blends_kept},
+          {"simulations", e.simulations},     {"simulated_ticks", e.simulated_ticks},
+          {"resumed_ticks", e.resumed_ticks}, {"seconds", e.seconds},
+          {"raw_seconds", e.raw_seconds},     {"fell_back", e.fell_back}};
 }
 
 nlohmann::json trajectory_json(const Trajectory& traj) {

@@ -308,6 +308,10 @@ std::vector<Step> shortcut_steps(Work& w, const RawChain& raw, std::vector<Step>
       if (i > 0 || j + 1 < m) limits.limit_scale *= kJunctionRoom;
       if (!direct_command(w.sim.robot, limits, to - from, w.sim.dt, direct.times, direct.knots))
         continue;
+      if (w.options.look && !line_looks_free(w.sim, w.ws, from, to)) {
+        ++w.stats.looked_blocked;
+        continue;
+      }
       ++attempts;
       const int last = static_cast<int>(direct.times.size()) - 1;
       const RolloutResult r = simulate_to_target(w, from, direct.times, direct.knots, 1, last, to,
@@ -629,6 +633,18 @@ std::optional<PathStep> direct_step(const Simulator& sim, SimulatorWorkspace& ws
   if (target >= static_cast<int>(goal.configurations.size())) return std::nullopt;
   return direct_step_to(sim, ws, limits, problem.start, goal.configurations[target], &goal,
                         simulations);
+}
+
+bool line_looks_free(const Simulator& sim, SimulatorWorkspace& ws, const JointVectorRef& from,
+                     const JointVectorRef& to, uint64_t* checks) {
+  const int steps = std::max(1, static_cast<int>(std::ceil((to - from).norm() / kLineLookStep)));
+  JointVector q(from.size());
+  for (int k = 1; k <= steps; ++k) {
+    q = from + (to - from) * (static_cast<double>(k) / steps);
+    if (checks) ++*checks;
+    if (check_state(sim, ws, q) != RolloutStatus::Valid) return false;
+  }
+  return true;
 }
 
 bool solves(const Simulator& sim, SimulatorWorkspace& ws, const PathStep& step, const Goal& goal) {

@@ -42,6 +42,10 @@ struct ExecutionOptions {
   // Shortened junction intervals, as fractions of the original two: the first within the
   // commanded limits is simulated; a failure is tried once more with the last, then stops.
   std::vector<double> blend_scales = {0.5, 0.6, 0.7, 0.8, 0.9};
+  // The shortcut pass looks at a candidate's joint-space line first (line_looks_free) and
+  // simulates only those whose line is free; a candidate left out so is not an attempt of the
+  // budget (false: every candidate simulated, the trajectories as before the look).
+  bool look = true;
 };
 
 // One rest-to-rest command of the executed trajectory: the joined knots of some steps.
@@ -59,12 +63,13 @@ struct ExecutionSegment {
 };
 
 struct ExecutionStats {
-  int raw_steps = 0;    // steps of the planner's path
-  int steps = 0;        // after shortcutting
-  int shortcuts = 0;    // runs of raw steps replaced by one direct command
-  int junctions = 0;    // between the steps after shortcutting
-  int blends_kept = 0;  // junctions passed without stopping
-  int stops = 0;        // junctions kept at rest (= junctions - blends_kept)
+  int raw_steps = 0;       // steps of the planner's path
+  int steps = 0;           // after shortcutting
+  int shortcuts = 0;       // runs of raw steps replaced by one direct command
+  int looked_blocked = 0;  // shortcut candidates whose line collided: left out unsimulated
+  int junctions = 0;       // between the steps after shortcutting
+  int blends_kept = 0;     // junctions passed without stopping
+  int stops = 0;           // junctions kept at rest (= junctions - blends_kept)
   int simulations =
       0;  // rollouts simulated by this stage (raw steps the planner did not hand over included)
   long simulated_ticks = 0;  // control ticks of those rollouts (not those a resumed one skipped)
@@ -145,6 +150,16 @@ std::optional<PathStep> direct_step(const Simulator& sim, SimulatorWorkspace& ws
 
 // Whether a step with an outcome ends valid at rest inside the goal region.
 bool solves(const Simulator& sim, SimulatorWorkspace& ws, const PathStep& step, const Goal& goal);
+
+// A look at a direct command before simulating it: whether every state of the joint-space line
+// from `from` to `to`, every kLineLookStep (and its end), passes the simulator's check of a
+// state (limits, collisions, tilt). A direct command moves from rest to rest along that line
+// within its tracking error, so one whose line collides is not worth a simulation (a look at a
+// state costs about what one control tick does; a simulation, hundreds of ticks). `checks`, when
+// given, gets the states checked added.
+constexpr double kLineLookStep = 0.05;  // rad (Euclidean, joint space)
+bool line_looks_free(const Simulator& sim, SimulatorWorkspace& ws, const JointVectorRef& from,
+                     const JointVectorRef& to, uint64_t* checks = nullptr);
 
 // Whether the direct step solves the problem: a problem that needs no planning.
 bool solved_by_direct_command(const Simulator& sim, SimulatorWorkspace& ws,

@@ -98,6 +98,16 @@ class SearchState {
     return check_state(ctx_.sim, ws_, q) == RolloutStatus::Valid;
   }
 
+  // Whether the joint-space line from `from` to `to` looks free (line_looks_free), its states
+  // counted as collision checks; `checks`, when given, gets them added too.
+  bool line_free(const JointVectorRef& from, const JointVectorRef& to, uint64_t* checks = nullptr) {
+    uint64_t looked = 0;
+    const bool free = line_looks_free(ctx_.sim, ws_, from, to, &looked);
+    result_.counters.collision_checks += looked;
+    if (checks) *checks += looked;
+    return free;
+  }
+
   RolloutResult simulate_from(const JointVectorRef& q, const CommandProfile& profile) {
     const RolloutResult r = simulate(ctx_.sim, ws_, q, profile);
     count(r);
@@ -148,12 +158,19 @@ class SearchState {
   // its first kDirectTargets configurations in turn). When it ends valid in the goal region it
   // is the solve's answer, found_by "direct" (no path is shorter by more than the goal's
   // tolerance, so the search is not run); true then.
-  bool connect_directly() {
+  // With `look`, a target whose joint-space line from the start collides (line_free) is not
+  // simulated.
+  bool connect_directly(bool look = false) {
+    const Goal& goal = problem_.goal;
     const int targets =
-        problem_.goal.kind == Goal::Kind::Joint
+        goal.kind == Goal::Kind::Joint
             ? 1
-            : std::min<int>(kDirectTargets, static_cast<int>(problem_.goal.configurations.size()));
+            : std::min<int>(kDirectTargets, static_cast<int>(goal.configurations.size()));
     for (int k = 0; k < std::max(1, targets); ++k) {
+      if (look && k < targets &&
+          !line_free(problem_.start,
+                     goal.kind == Goal::Kind::Joint ? goal.q : goal.configurations[k]))
+        continue;
       int simulations = 0;
       std::optional<PathStep> step =
           direct_step(ctx_.sim, ws_, ctx_.command, problem_, &simulations, k);

@@ -38,7 +38,7 @@ constexpr size_t kGrowthTries = 8;
 // goal, up to kApproachCount of them within kApproachWidening x the neighbourhood, are shifted to
 // end at the goal. A direct command that collides then tries, from its real node, the nearest of
 // the approaches within kApproachReach, up to kApproachTries of them, whose edge and straight line
-// look free (the line checked every kLineStep), landing within kApproachLanding of it. Chosen on
+// look free (line_looks_free), landing within kApproachLanding of it. Chosen on
 // clutter-6571, 6572, 903, 8232, 9311 and shelf-6573 (60 runs each): after 2 collided commands
 // the approaches cost the easy problems 3-7 ms; after 5, landing within 0.05 rather than 0.02
 // rad (fewer corrections), the medians fell in five of the six. Looking at the approaches at
@@ -51,7 +51,6 @@ constexpr size_t kApproachTries = 8;
 constexpr double kApproachWidening = 2;
 constexpr double kApproachReach = 0.8;     // rad
 constexpr double kApproachLanding = 0.05;  // rad
-constexpr double kLineStep = 0.05;         // rad
 constexpr double kHeadStart = 50;          // rollouts' worth of lazy work before growth gets a turn
 constexpr double kLazyShare = 3;           // then lazy work may be up to 3x the growth's,
 // divided by 1 + (failed candidates) / this: where the scene keeps blocking what the bundle
@@ -243,7 +242,7 @@ class LazySpSearch {
   std::unordered_set<uint64_t> tried_;  // (real node, edge) pairs simulated, valid or not
   // By the cell of a source state: edges whose stored samples, shifted there, collided (precheck).
   std::unordered_map<uint64_t, std::unordered_set<uint32_t>> blocked_;
-  JointVector probe_;  // shifted_samples_free's and line_looks_free's scratch
+  JointVector probe_;  // shifted_samples_free's scratch
   // grow_along_bundle's scratch, and approach_from's (reached from grow_along_bundle's last use
   // of it, through reached_by_growth)
   std::vector<std::pair<double, uint32_t>> ranked_;
@@ -268,7 +267,7 @@ class LazySpSearch {
 };
 
 PlanResult LazySpSearch::run() {
-  if (set_.direct && s_.connect_directly()) return s_.result();
+  if (set_.direct && s_.connect_directly(set_.precheck)) return s_.result();
   RolloutResult at_start;
   at_start.qf = s_.problem().start;
   add_real(at_start, -1, -1, -1);
@@ -568,13 +567,16 @@ bool LazySpSearch::connect_to_goal(int v) {
   const LazySpNode& node = s_.node(v);
   const Goal& goal = s_.problem().goal;
   std::optional<PathStep> step;
+  bool looked_blocked = false;  // a joint goal's line collided: not simulated, as if it had
   if (goal.kind != Goal::Kind::Joint) {
     step = s_.goal_connection(node.q, simulations);
   } else if (set_.connect_radius > 0 && node.h <= set_.connect_radius) {
-    step = s_.connection(node.q, goal.q, simulations);
+    looked_blocked = set_.precheck && !line_looks_free(node.q, goal.q);
+    if (!looked_blocked) step = s_.connection(node.q, goal.q, simulations);
   }
   if (step) return reached_by_connection(v, std::move(*step), "connection");
-  if (simulations == 0 || goal.kind != Goal::Kind::Joint || !looks_ || !set_.approaches)
+  if ((simulations == 0 && !looked_blocked) || goal.kind != Goal::Kind::Joint || !looks_ ||
+      !set_.approaches)
     return false;
   if (++collided_connections_ >= kApproachAfter && !looked_for_approaches_) look_for_approaches();
   return !approaches_.empty() && approach_to_goal(v);
@@ -598,8 +600,7 @@ bool LazySpSearch::reached_by_connection(int v, PathStep step, const char* by) {
 void LazySpSearch::look_for_approaches() {
   looked_for_approaches_ = true;
   const JointVector& goal = s_.problem().goal.q;
-  edges_ending_nearest(ctx_, goal, kApproachCount, kApproachWidening * neighbourhood_,
-                       neighbours_);
+  edges_ending_nearest(ctx_, goal, kApproachCount, kApproachWidening * neighbourhood_, neighbours_);
   for (const auto& [e, distance] : neighbours_) {
     displacement(e, step_);
     JointVector x = goal - step_;
@@ -661,16 +662,10 @@ int LazySpSearch::approach_from(const JointVector& q) {
   return -1;
 }
 
-// The joint-space line from `from` to `to`, checked every kLineStep as the simulator checks a
-// state (a direct command follows it from rest to rest, within its tracking error).
+// The joint-space line from `from` to `to`, looked at as line_looks_free does (a direct command
+// follows it from rest to rest, within its tracking error); its states count as the look's.
 bool LazySpSearch::line_looks_free(const JointVector& from, const JointVector& to) {
-  const int steps = std::max(1, static_cast<int>(std::ceil((to - from).norm() / kLineStep)));
-  for (int k = 1; k <= steps; ++k) {
-    probe_ = from + (to - from) * (static_cast<double>(k) / steps);
-    ++prechecks_;
-    if (!s_.state_free(probe_)) return false;
-  }
-  return true;
+  return s_.line_free(from, to, &prechecks_);
 }
 
 int LazySpSearch::add_real(const RolloutResult& r, int parent, int64_t edge, int command) {
@@ -785,8 +780,9 @@ PlannerInfo lazysp_planner_info() {
                      "tolerance)"),
       boolean_parameter("precheck", true,
                         "look at a candidate's edges (their stored samples shifted to the "
-                        "predicted starts) and the growth's bundle edges before simulating; "
-                        "false: simulate at once, grow by random commands only"),
+                        "predicted starts), the growth's bundle edges and the direct commands' "
+                        "joint-space lines before simulating; false: simulate at once, grow by "
+                        "random commands only"),
       boolean_parameter("approaches", true,
                         "where direct commands into a joint goal keep colliding, look backward "
                         "from it (bundle edges shifted to end there) and come in along one "
