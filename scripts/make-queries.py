@@ -11,6 +11,11 @@ Any robot (its dof and sampling region from `lazyboe-robot info --json`).
 --blocked keeps only pairs whose straight joint-space line collides in the scene (checked at
 every 0.02 rad with lazyboe-robot check): problems a single straight command cannot solve. It
 prints the share of candidate pairs that were blocked.
+
+Candidates are drawn in rounds of 40 per problem (paired in the order drawn) until COUNT
+problems are found, up to 25 rounds: a crowded scene leaves few free configurations and fewer
+blocked pairs. The first round is the whole draw of earlier versions, so a set those could
+draw comes out the same.
 """
 import argparse, csv, json, math, os, random, subprocess, sys, tempfile
 
@@ -75,23 +80,33 @@ def line_blocked(s, g):
     return not all(check(line, clearance=-1))  # a collision (at the robot's margin), not 3 cm
 
 
-cand = [[round(rng.uniform(l, h), 4) for l, h in zip(lo, hi)] for _ in range(40 * a.count)]
-free = [q for q, ok in zip(cand, check(cand)) if ok]
+# Candidates in rounds of 40 per problem, paired in the order drawn, until there are enough (a
+# crowded scene leaves few free configurations, and few pairs with a blocked line): the first
+# round is what a single draw gave, so sets drawn before rounds existed come out the same.
+MAX_ROUNDS = 25
 pairs, tried, blocked = [], 0, 0
-for i in range(0, len(free) - 1, 2):
+for round_ in range(MAX_ROUNDS):
+    cand = [[round(rng.uniform(l, h), 4) for l, h in zip(lo, hi)] for _ in range(40 * a.count)]
+    free = [q for q, ok in zip(cand, check(cand)) if ok]
+    for i in range(0, len(free) - 1, 2):
+        if len(pairs) == a.count:
+            break
+        s, g = free[i], free[i + 1]
+        if math.dist(s, g) < a.min_separation:
+            continue
+        tried += 1
+        if a.blocked:
+            if not line_blocked(s, g):
+                continue
+            blocked += 1
+        pairs.append((s, g))
     if len(pairs) == a.count:
         break
-    s, g = free[i], free[i + 1]
-    if math.dist(s, g) < a.min_separation:
-        continue
-    tried += 1
-    if a.blocked:
-        if not line_blocked(s, g):
-            continue
-        blocked += 1
-    pairs.append((s, g))
+    print(f"make-queries: {len(pairs)} of {a.count} problems after round {round_ + 1}; drawing more",
+          file=sys.stderr)
 if len(pairs) < a.count:
-    sys.exit(f"make-queries: only {len(pairs)} of {a.count} problems found; try another seed or scene")
+    sys.exit(f"make-queries: only {len(pairs)} of {a.count} problems found in {MAX_ROUNDS} rounds "
+             f"of {40 * a.count} candidates; try another seed or scene")
 if a.blocked:
     print(f"{blocked} of {tried} pairs tried had a blocked straight line "
           f"({100.0 * blocked / tried:.0f}%)", file=sys.stderr)
