@@ -102,8 +102,9 @@ for round_ in range(MAX_ROUNDS):
         pairs.append((s, g))
     if len(pairs) == a.count:
         break
-    print(f"make-queries: {len(pairs)} of {a.count} problems after round {round_ + 1}; drawing more",
-          file=sys.stderr)
+    if round_ + 1 < MAX_ROUNDS:
+        print(f"make-queries: {len(pairs)} of {a.count} problems after round {round_ + 1}; "
+              "drawing more", file=sys.stderr)
 if len(pairs) < a.count:
     sys.exit(f"make-queries: only {len(pairs)} of {a.count} problems found in {MAX_ROUNDS} rounds "
              f"of {40 * a.count} candidates; try another seed or scene")

@@ -567,6 +567,25 @@ TEST(Execution, TheShortcutPassLooksBeforeItSimulates) {
   }
 }
 
+// lazysp (with precheck, its default) looks at the straight command's line first: where the
+// line is blocked it spends no simulation on it, where precheck is off it simulates it. A budget
+// that has ended when the search would begin leaves only that attempt to count.
+TEST(Execution, LazySpLooksAtTheStraightCommandBeforeSimulatingIt) {
+  const Fixture& f = fixture();
+  PlanningProblem p = problem_to(f.a, f.b);
+  Obstructed o;
+  ASSERT_TRUE(block_line(p, o)) << "no ball on the line clears the start and the goal";
+  p.termination.budget = 1e-9;
+  const PlanningContext context = bundle_context(*o.sim, f.view, f.index);
+  SimulatorWorkspace ws(*o.sim);
+  const PlanResult looked = plan(context, ws, "lazysp", {}, p);
+  const PlanResult blind = plan(context, ws, "lazysp", {{"precheck", 0}}, p);
+  EXPECT_FALSE(looked.success);
+  EXPECT_EQ(looked.counters.simulations, 0u);
+  EXPECT_GT(looked.counters.collision_checks, 0u);
+  EXPECT_EQ(blind.counters.simulations, 1u);
+}
+
 TEST(Execution, DirectCommandIsAStraightLineWithinTheCommandLimits) {
   const Fixture& f = fixture();
   const ExecutionOptions o = options(true, true);

@@ -548,7 +548,8 @@ TEST(LazySp, TheEndStateIndexAgreesWithAScan) {
 
 // Without the end-state index (a context that has none), the coverage checks scan every end
 // state and answer exactly as the index does: the same edges within, whether there is one, and
-// the same nearest ones in the same order, also at a radius that is an edge end's exact distance.
+// the same nearest ones in the same order, also at a radius whose square is an edge end's
+// squared distance (strictly within: that end is out).
 TEST(LazySp, CoverageWithoutTheEndIndexAnswersAsWithIt) {
   const Fixture& f = fixture();
   const PlanningContext indexed = session_context(f, f.sim);
@@ -558,11 +559,22 @@ TEST(LazySp, CoverageWithoutTheEndIndexAnswersAsWithIt) {
   std::vector<JointVector> queries = {f.a, f.b, f.c};
   for (const size_t e : {size_t{0}, f.view.size() / 2})
     queries.push_back(Eigen::Map<const Eigen::VectorXd>(f.view.qf(e), f.robot.dof));
-  size_t nonempty = 0;
+  size_t nonempty = 0, exact_boundaries = 0;
   for (const JointVector& q : queries) {
     std::vector<double> radii = {1e-9, 0.1, 0.3, 0.75};
     edge_ends_near(indexed, q, 0.75, by_index);
-    if (!by_index.empty()) radii.push_back(std::sqrt(by_index[by_index.size() / 2].second));
+    if (!by_index.empty()) {
+      // A radius whose square is an edge end's squared distance exactly: that end is out.
+      const auto [edge, d2] = by_index[by_index.size() / 2];
+      double r = std::sqrt(d2);
+      for (int k = 0; k < 8 && r * r != d2; ++k) r = std::nextafter(r, r * r < d2 ? 1e9 : 0.0);
+      if (r * r == d2) {
+        radii.push_back(r);
+        edge_ends_near(scanning, q, r, by_scan);
+        for (const auto& [e, d] : by_scan) EXPECT_NE(e, edge) << "the boundary is strict";
+        ++exact_boundaries;
+      }
+    }
     for (const double radius : radii) {
       const bool found = edge_ends_near(indexed, q, radius, by_index);
       EXPECT_EQ(edge_ends_near(scanning, q, radius, by_scan), found);
@@ -579,6 +591,7 @@ TEST(LazySp, CoverageWithoutTheEndIndexAnswersAsWithIt) {
     }
   }
   EXPECT_GT(nonempty, 5u) << "the queries found too few edge ends to compare";
+  EXPECT_GT(exact_boundaries, 0u) << "no radius fell exactly on an edge end";
 }
 
 // A lazysp result passes realize_path on `sim`, the independent re-validation, and its

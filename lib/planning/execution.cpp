@@ -309,7 +309,7 @@ std::vector<Step> shortcut_steps(Work& w, const RawChain& raw, std::vector<Step>
       if (!direct_command(w.sim.robot, limits, to - from, w.sim.dt, direct.times, direct.knots))
         continue;
       if (w.options.look && !line_looks_free(w.sim, w.ws, from, to)) {
-        ++w.stats.looked_blocked;
+        if (++w.stats.looked_blocked % ExecutionOptions::kLooksPerAttempt == 0) ++attempts;
         continue;
       }
       ++attempts;
@@ -638,7 +638,7 @@ std::optional<PathStep> direct_step(const Simulator& sim, SimulatorWorkspace& ws
 bool line_looks_free(const Simulator& sim, SimulatorWorkspace& ws, const JointVectorRef& from,
                      const JointVectorRef& to, uint64_t* checks) {
   const int steps = std::max(1, static_cast<int>(std::ceil((to - from).norm() / kLineLookStep)));
-  JointVector q(from.size());
+  JointVector q(from.size());  // of fixed capacity (kMaxDof): no allocation
   for (int k = 1; k <= steps; ++k) {
     q = from + (to - from) * (static_cast<double>(k) / steps);
     if (checks) ++*checks;

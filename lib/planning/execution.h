@@ -43,9 +43,13 @@ struct ExecutionOptions {
   // commanded limits is simulated; a failure is tried once more with the last, then stops.
   std::vector<double> blend_scales = {0.5, 0.6, 0.7, 0.8, 0.9};
   // The shortcut pass looks at a candidate's joint-space line first (line_looks_free) and
-  // simulates only those whose line is free; a candidate left out so is not an attempt of the
-  // budget (false: every candidate simulated, the trajectories as before the look).
+  // simulates only those whose line is free; every kLooksPerAttempt candidates left out so use
+  // one attempt of the budget (false: every candidate simulated, the trajectories as before the
+  // look).
   bool look = true;
+  // A blocked look costs about 20-50 checked states, a simulation hundreds of ticks; the budget
+  // still bounds the looks of a long path (m steps have about m^2 / 2 candidates).
+  static constexpr int kLooksPerAttempt = 4;
 };
 
 // One rest-to-rest command of the executed trajectory: the joined knots of some steps.
@@ -151,12 +155,12 @@ std::optional<PathStep> direct_step(const Simulator& sim, SimulatorWorkspace& ws
 // Whether a step with an outcome ends valid at rest inside the goal region.
 bool solves(const Simulator& sim, SimulatorWorkspace& ws, const PathStep& step, const Goal& goal);
 
-// A look at a direct command before simulating it: whether every state of the joint-space line
-// from `from` to `to`, every kLineLookStep (and its end), passes the simulator's check of a
-// state (limits, collisions, tilt). A direct command moves from rest to rest along that line
-// within its tracking error, so one whose line collides is not worth a simulation (a look at a
-// state costs about what one control tick does; a simulation, hundreds of ticks). `checks`, when
-// given, gets the states checked added.
+// A look at a direct command before simulating it: whether the states of the joint-space line
+// from `from` to `to`, evenly spaced at most kLineLookStep apart, its end included (not `from`:
+// the command starts there), pass the simulator's check of a state (limits, collisions, tilt). A
+// direct command moves from rest to rest along that line within its tracking error, so one whose
+// line collides is not worth a simulation (a look at a state costs about what one control tick
+// does; a simulation, hundreds of ticks). `checks`, when given, gets the states checked added.
 constexpr double kLineLookStep = 0.05;  // rad (Euclidean, joint space)
 bool line_looks_free(const Simulator& sim, SimulatorWorkspace& ws, const JointVectorRef& from,
                      const JointVectorRef& to, uint64_t* checks = nullptr);

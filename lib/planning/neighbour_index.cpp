@@ -182,7 +182,7 @@ struct Search {
   }
 
   // Searches from the root, whose cell is the points' bounding box; returns whether a point
-  // was found (for SearchMode::Any).
+  // was found.
   bool run() {
     double bound = 0;
     for (int d = 0; d < dof; ++d) {
@@ -191,6 +191,7 @@ struct Search {
       bound += cell[d];
     }
     if (bound <= prune) visit(0, bound);
+    if constexpr (Mode == SearchMode::Nearest) return !out->empty();
     return found;
   }
 };

@@ -158,8 +158,8 @@ class SearchState {
   // its first kDirectTargets configurations in turn). When it ends valid in the goal region it
   // is the solve's answer, found_by "direct" (no path is shorter by more than the goal's
   // tolerance, so the search is not run); true then.
-  // With `look`, a target whose joint-space line from the start collides (line_free) is not
-  // simulated.
+  // With `look`, a target (the joint goal, or one of a pose goal's configurations) whose
+  // joint-space line from the start collides (line_free) is not simulated.
   bool connect_directly(bool look = false) {
     const Goal& goal = problem_.goal;
     const int targets =

@@ -37,7 +37,7 @@ double nearest_edge(const PlanningContext& ctx, const JointVectorRef& q, bool en
   if (!index) {                         // no end index: every end state, as edge_ends_near does
     const int n = ctx.bundle->dof();
     for (size_t e = 0; e < ctx.bundle->size(); ++e)
-      nearest = std::min(nearest, (row(ctx.bundle->qf(e), n) - q).squaredNorm());
+      nearest = std::min(nearest, squared_distance(q.data(), ctx.bundle->qf(e), n));
     return std::sqrt(nearest);
   }
   std::vector<std::pair<uint32_t, double>> found;
