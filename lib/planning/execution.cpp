@@ -628,19 +628,25 @@ std::optional<PathStep> direct_step(const Simulator& sim, SimulatorWorkspace& ws
                                     const CommandSampling& limits, const PlanningProblem& problem,
                                     int* simulations, int target) {
   const Goal& goal = problem.goal;
-  if (goal.kind == Goal::Kind::Joint)
-    return direct_step_to(sim, ws, limits, problem.start, goal.q, nullptr, simulations);
-  if (target >= static_cast<int>(goal.configurations.size())) return std::nullopt;
-  return direct_step_to(sim, ws, limits, problem.start, goal.configurations[target], &goal,
-                        simulations);
+  const JointVector* to = direct_target(goal, target);
+  if (!to) return std::nullopt;
+  return direct_step_to(sim, ws, limits, problem.start, *to,
+                        goal.kind == Goal::Kind::Joint ? nullptr : &goal, simulations);
+}
+
+const JointVector* direct_target(const Goal& goal, int target) {
+  if (goal.kind == Goal::Kind::Joint) return &goal.q;
+  if (target >= static_cast<int>(goal.configurations.size())) return nullptr;
+  return &goal.configurations[target];
 }
 
 bool line_looks_free(const Simulator& sim, SimulatorWorkspace& ws, const JointVectorRef& from,
                      const JointVectorRef& to, uint64_t* checks) {
-  const int steps = std::max(1, static_cast<int>(std::ceil((to - from).norm() / kLineLookStep)));
-  JointVector q(from.size());  // of fixed capacity (kMaxDof): no allocation
+  const JointVector span = to - from;  // of fixed capacity (kMaxDof): no allocation
+  const int steps = std::max(1, static_cast<int>(std::ceil(span.norm() / kLineLookStep)));
+  JointVector q(from.size());
   for (int k = 1; k <= steps; ++k) {
-    q = from + (to - from) * (static_cast<double>(k) / steps);
+    q = from + span * (static_cast<double>(k) / steps);
     if (checks) ++*checks;
     if (check_state(sim, ws, q) != RolloutStatus::Valid) return false;
   }

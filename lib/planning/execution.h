@@ -147,6 +147,9 @@ std::optional<PathStep> direct_step_to(const Simulator& sim, SimulatorWorkspace&
                                        const CommandSampling& limits, const JointVectorRef& from,
                                        const JointVector& target, const Goal* land_in,
                                        int* simulations = nullptr);
+// What direct_step aims at: the joint goal, or a pose goal's configuration `target`; null when
+// it has no such configuration.
+const JointVector* direct_target(const Goal& goal, int target);
 // `target`: which of a pose goal's configurations (0: the nearest the start).
 std::optional<PathStep> direct_step(const Simulator& sim, SimulatorWorkspace& ws,
                                     const CommandSampling& limits, const PlanningProblem& problem,

@@ -167,10 +167,8 @@ class SearchState {
             ? 1
             : std::min<int>(kDirectTargets, static_cast<int>(goal.configurations.size()));
     for (int k = 0; k < std::max(1, targets); ++k) {
-      if (look && k < targets &&
-          !line_free(problem_.start,
-                     goal.kind == Goal::Kind::Joint ? goal.q : goal.configurations[k]))
-        continue;
+      const JointVector* target = direct_target(goal, k);
+      if (look && target && !line_free(problem_.start, *target)) continue;
       int simulations = 0;
       std::optional<PathStep> step =
           direct_step(ctx_.sim, ws_, ctx_.command, problem_, &simulations, k);
