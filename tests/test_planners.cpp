@@ -950,5 +950,57 @@ TEST(LazySp, AGoalInAPocketIsApproachedAlongAnEdgeLookedAtBackward) {
             << (without.success ? "solved" : "not solved") << ")\n";
 }
 
+// The goal test's look: the lazy search's candidate for a joint goal ends where the straight line
+// into the goal looks free. In the fixture's scene, a problem's answer ends with the direct
+// command from a candidate's last state; there the look changes nothing but the checks it costs.
+// A ball on that command's line, a quarter of the way in, blocks it: without the look, that
+// candidate and its neighbours are simulated before their connections are found blocked; with
+// it, they are passed over unsimulated.
+TEST(LazySp, TheGoalTestLooksAtTheLineIntoTheGoal) {
+  const Fixture& f = fixture();
+  const ParameterValues on = searching("lazysp", {{"connect_radius", 1.5}});
+  const ParameterValues off = searching("lazysp", {{"connect_radius", 1.5}, {"goal_look", 0}});
+  int blocked_problems = 0;
+  uint64_t simulations_looked = 0, simulations_without = 0;
+  for (const auto& [from, to] : std::vector<std::pair<JointVector, JointVector>>{
+           {f.a, f.c}, {f.c, f.a}, {f.b, f.c}, {f.c, f.b}}) {
+    PlanningProblem p = library_problem(from, to, 10);
+    p.termination.stop_at_first = true;
+    SimulatorWorkspace ws(f.sim);
+    const PlanningContext open = session_context(f, f.sim);
+    const PlanResult clear = plan(open, ws, "lazysp", off, p);
+    const PlanResult clear_looked = plan(open, ws, "lazysp", on, p);
+    ASSERT_TRUE(clear.success && clear_looked.success) << clear.failure;
+    EXPECT_EQ(clear_looked.best_cost, clear.best_cost);
+    EXPECT_EQ(clear_looked.counters.simulations, clear.counters.simulations);
+    EXPECT_GT(clear_looked.counters.collision_checks, clear.counters.collision_checks);
+    if (clear.found_by != "connection" || clear.best_path.size() < 2) continue;
+    // The state the connection started from, and a ball on its line into the goal.
+    const Trajectory t = realize_path(f.sim, ws, p.start, clear.best_path, p.goal, 0);
+    const double t_end = t.duration - clear.best_path.back().outcome->duration;
+    size_t k = 0;
+    while (k + 1 < t.t.size() && t.t[k] < t_end - 1e-9) ++k;
+    const JointVector end = t.q[k];
+    const auto scene = scene_with_ball(f, end + 0.25 * (p.goal.q - end), 0.03);
+    SimulatorWorkspace bws(scene->sim);
+    if (check_state(scene->sim, bws, p.start) != RolloutStatus::Valid ||
+        check_state(scene->sim, bws, p.goal.q) != RolloutStatus::Valid)
+      continue;
+    const PlanningContext context = session_context(f, scene->sim);
+    const PlanResult looked = plan(context, bws, "lazysp", on, p);
+    const PlanResult without = plan(context, bws, "lazysp", off, p);
+    ASSERT_TRUE(looked.success) << looked.failure;
+    expect_revalidated(f, scene->sim, p, looked);
+    simulations_looked += looked.counters.simulations;
+    simulations_without += without.counters.simulations;
+    ++blocked_problems;
+  }
+  ASSERT_GE(blocked_problems, 2) << "too few answers end with a connection: the test shows little";
+  std::cout << "[ lazysp  ] the goal test's look, " << blocked_problems
+            << " problems with a ball on the way in: " << simulations_looked << " simulations, "
+            << simulations_without << " without it\n";
+  EXPECT_LT(simulations_looked, simulations_without);
+}
+
 }  // namespace
 }  // namespace lazyboe::test

@@ -103,8 +103,8 @@ TEST(Registry, NamesAndLookups) {
                                    "pruning_ratio", "epsilon", "resolution", "risk_weight",
                                    "edge_penalty", "expansion_limit", "mark_weight", "direct",
                                    "connect_radius", "candidate_radius", "precheck",
-                                   "approaches"}));
-  EXPECT_EQ(all.size(), 16u);  // each once
+                                   "approaches", "goal_look"}));
+  EXPECT_EQ(all.size(), 17u);  // each once
 }
 
 // The refusals only: a planner registered here would stay for the other tests of a process that
