@@ -990,6 +990,7 @@ TEST(LazySp, TheGoalTestLooksAtTheLineIntoTheGoal) {
     const PlanResult looked = plan(context, bws, "lazysp", on, p);
     const PlanResult without = plan(context, bws, "lazysp", off, p);
     ASSERT_TRUE(looked.success) << looked.failure;
+    ASSERT_TRUE(without.success) << without.failure;  // else its count is the budget's
     expect_revalidated(f, scene->sim, p, looked);
     simulations_looked += looked.counters.simulations;
     simulations_without += without.counters.simulations;

@@ -71,11 +71,12 @@ constexpr size_t kMarkedSearchLimit = 1000;
 // 92 / 97 / 98 (shelf, seed 6464), medians 30 / 12 / 11 ms (table).
 constexpr double kTiltWidening = 1.5;
 // The goal test's look (may_end_candidate): a round passes over at most this many candidate ends
-// whose straight line into a joint goal looks blocked. Chosen on 12 tuning sets (clutter, boards,
-// shelves; 30-60 runs each, docs/performance.md) from 16 / 64 / 256: against no look, the
-// geometric means over the sets of the median time to an executable trajectory were 0.92 / 0.96
-// / 0.92 and of the mean time to first solution (a miss 5 s) 1.02 / 0.93 / 0.86. Halving it
-// after each round that used it up, or a limit in expansions instead, did no better.
+// whose straight line into a joint goal looks blocked (looked at then or remembered). Chosen on 12
+// tuning sets (clutter, boards, shelves; 30-60 runs each, docs/performance.md) from 16 / 64 / 256,
+// measured before the looks counted as lazy work: against no look, the geometric means over the
+// sets of the median time to an executable trajectory were 0.92 / 0.96 / 0.92 and of the mean
+// time to first solution (a miss 5 s) 1.02 / 0.93 / 0.86. Halving it after each round that used
+// it up, or a limit in expansions instead, did no better.
 constexpr int kGoalLineRejections = 256;
 // Bytes the memo of the lazy search's radius queries may hold before it starts again empty
 // (a failing 5 s solve on the 100k table bundle expands about 10^5 states of tens of edges).
@@ -126,8 +127,8 @@ class LazySpSearch {
         lazy_goal_radius_(lazy_goal_radius(set_, solve.problem.goal)),
         looks_(set_.precheck && bundle_.header().sample_interval > 0),
         memo_(*ctx_.index, neighbourhood_, ctx_.sim.robot.dof, kMemoBytes),
-        goal_lines_looked_(looks_ && solve.problem.goal.kind == Goal::Kind::Joint &&
-                           set_.connect_radius > 0 && set_.goal_look) {}
+        looks_at_goal_line_free_by_cell_(looks_ && solve.problem.goal.kind == Goal::Kind::Joint &&
+                                         set_.connect_radius > 0 && set_.goal_look) {}
 
   PlanResult run();
 
@@ -253,8 +254,8 @@ class LazySpSearch {
   bool goal_covered_ = true;
   std::unordered_set<uint64_t> tried_;  // (real node, edge) pairs simulated, valid or not
   // may_end_candidate: whether it looks at all, the looks by cell, this round's rejections
-  const bool goal_lines_looked_;
-  std::unordered_map<uint64_t, bool> goal_lines_;
+  const bool looks_at_goal_line_free_by_cell_;
+  std::unordered_map<uint64_t, bool> goal_line_free_by_cell_;
   int goal_line_rejections_ = 0;
   // By the cell of a source state: edges whose stored samples, shifted there, collided (precheck).
   std::unordered_map<uint64_t, std::unordered_set<uint32_t>> blocked_;
@@ -431,16 +432,17 @@ int LazySpSearch::expand(int p) {
 
 // The goal test's look: a candidate ending at predicted state p, in the lazy goal region of a
 // joint goal but not in the goal, reaches it by the direct command from its real end
-// (connect_to_goal), whose look finds the line blocked for most ends in clutter (8 to 42 per
-// solve on the tuning sets, each after a candidate's simulation). Here the line from p is looked
-// at first, once per cell: a blocked one leaves p a state of the search, not a candidate. Up to
-// kGoalLineRejections per round, then ends are taken as before: where every line in is blocked
-// (a pocket) the round goes on as without the look, and the approaches come in.
+// (connect_to_goal), whose look would find the line blocked for most such ends in clutter, after
+// the candidate's simulation. So the line from p is looked at first, once per cell: a blocked one
+// leaves p a state of the search, not a candidate. Up to kGoalLineRejections per round; then ends
+// are taken as before, so that where every line in is blocked (a pocket) the connections are
+// still tried and the approaches start (or, when a round runs out of states first, the growth's
+// nodes try them).
 bool LazySpSearch::may_end_candidate(int p, double h) {
-  if (!goal_lines_looked_ || h <= s_.problem().goal.tolerance ||
+  if (!looks_at_goal_line_free_by_cell_ || h <= s_.problem().goal.tolerance ||
       goal_line_rejections_ >= kGoalLineRejections)
     return true;
-  const auto [it, fresh] = goal_lines_.try_emplace(preds_[p].cell, true);
+  const auto [it, fresh] = goal_line_free_by_cell_.try_emplace(preds_[p].cell, true);
   if (fresh) it->second = s_.line_free(preds_[p].q, s_.problem().goal.q, &prechecks_);
   if (!it->second) ++goal_line_rejections_;
   return it->second;
