@@ -127,8 +127,8 @@ class LazySpSearch {
         lazy_goal_radius_(lazy_goal_radius(set_, solve.problem.goal)),
         looks_(set_.precheck && bundle_.header().sample_interval > 0),
         memo_(*ctx_.index, neighbourhood_, ctx_.sim.robot.dof, kMemoBytes),
-        looks_at_goal_line_free_by_cell_(looks_ && solve.problem.goal.kind == Goal::Kind::Joint &&
-                                         set_.connect_radius > 0 && set_.goal_look) {}
+        looks_at_goal_lines_(set_.precheck && solve.problem.goal.kind == Goal::Kind::Joint &&
+                             set_.connect_radius > 0 && set_.goal_look) {}
 
   PlanResult run();
 
@@ -253,8 +253,9 @@ class LazySpSearch {
   bool looked_for_approaches_ = false;
   bool goal_covered_ = true;
   std::unordered_set<uint64_t> tried_;  // (real node, edge) pairs simulated, valid or not
-  // may_end_candidate: whether it looks at all, the looks by cell, this round's rejections
-  const bool looks_at_goal_line_free_by_cell_;
+  // may_end_candidate: whether it looks at all, the looks by cell (one entry per line looked at,
+  // each at least one checked state: bounded by the solve's checks), this round's rejections
+  const bool looks_at_goal_lines_;
   std::unordered_map<uint64_t, bool> goal_line_free_by_cell_;
   int goal_line_rejections_ = 0;
   // By the cell of a source state: edges whose stored samples, shifted there, collided (precheck).
@@ -439,7 +440,7 @@ int LazySpSearch::expand(int p) {
 // still tried and the approaches start (or, when a round runs out of states first, the growth's
 // nodes try them).
 bool LazySpSearch::may_end_candidate(int p, double h) {
-  if (!looks_at_goal_line_free_by_cell_ || h <= s_.problem().goal.tolerance ||
+  if (!looks_at_goal_lines_ || h <= s_.problem().goal.tolerance ||
       goal_line_rejections_ >= kGoalLineRejections)
     return true;
   const auto [it, fresh] = goal_line_free_by_cell_.try_emplace(preds_[p].cell, true);
