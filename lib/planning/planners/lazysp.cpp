@@ -440,8 +440,7 @@ int LazySpSearch::expand(int p) {
 // still tried and the approaches start (or, when a round runs out of states first, the growth's
 // nodes try them).
 bool LazySpSearch::may_end_candidate(int p, double h) {
-  if (!looks_at_goal_lines_ || h <= s_.problem().goal.tolerance ||
-      goal_line_rejections_ >= kGoalLineRejections)
+  if (!looks_at_goal_lines_ || s_.in_goal(h) || goal_line_rejections_ >= kGoalLineRejections)
     return true;
   const auto [it, fresh] = goal_line_free_by_cell_.try_emplace(preds_[p].cell, true);
   if (fresh) it->second = s_.line_free(preds_[p].q, s_.problem().goal.q, &prechecks_);
