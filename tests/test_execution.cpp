@@ -567,6 +567,86 @@ TEST(Execution, TheShortcutPassLooksBeforeItSimulates) {
   }
 }
 
+// A correction round adds the residual to the last knot of the corrected range only
+// (correction_knots 1), so it goes on from the rollout's checkpoint before that knot: fewer ticks
+// simulated than with the correction spread over the range (0), and both trajectories pass
+// re-simulation and the independent checker, at rest in the goal.
+TEST(Execution, ACorrectionRoundGoesOnFromBeforeTheLastKnot) {
+  const Fixture& f = fixture();
+  const PathCase& c = long_path();
+  ASSERT_TRUE(c.result.success) << c.result.failure;
+  ExecutionOptions late = options(true, true), spread = late;
+  spread.correction_knots = 0;
+  const ExecutableTrajectory a = execute(f.sim, c, late);
+  const ExecutableTrajectory b = execute(f.sim, c, spread);
+  EXPECT_GT(a.stats.resumed_ticks, b.stats.resumed_ticks);
+  EXPECT_LT(a.stats.simulated_ticks, b.stats.simulated_ticks);
+  for (const ExecutableTrajectory* e : {&a, &b}) {
+    EXPECT_FALSE(e->stats.fell_back);
+    EXPECT_EQ(resimulate_segments(f.sim, *e, c.problem.start), "");
+    EXPECT_EQ(checker_verdict(f.sim, e->trajectory), "");
+    expect_at_rest_ends(f.sim, *e, c.problem);
+  }
+}
+
+// A shortcut whose line looks free is taken without a simulation of its own: the blend pass
+// simulates it as the first part of its segment. The same shortcuts, fewer ticks than simulating
+// each shortcut first, and a trajectory that passes re-simulation and the independent checker.
+TEST(Execution, ALookedShortcutIsSimulatedOnlyInItsSegment) {
+  const Fixture& f = fixture();
+  const PlanningProblem p = problem_to(f.b, f.c);
+  Obstructed o;  // the line blocked: lazysp's path of a few edges, shortcut in part
+  ASSERT_TRUE(block_line(p, o)) << "no ball on the line clears the start and the goal";
+  const PlanningContext context = bundle_context(*o.sim, f.view, f.index);
+  SimulatorWorkspace ws(*o.sim);
+  const PlanResult r = plan(context, ws, "lazysp", searching("lazysp"), p);
+  ASSERT_TRUE(r.success) << r.failure;
+  ExecutionOptions looked = options(true, true), simulated = looked;
+  simulated.looked_shortcuts = false;
+  const ExecutableTrajectory a =
+      make_executable(*o.sim, ws, p.start, r.best_path, p.goal, looked, 1);
+  const ExecutableTrajectory b =
+      make_executable(*o.sim, ws, p.start, r.best_path, p.goal, simulated, 1);
+  EXPECT_GE(a.stats.shortcuts, 1);
+  EXPECT_GE(a.stats.steps, 2);
+  EXPECT_EQ(a.stats.shortcuts, b.stats.shortcuts);
+  EXPECT_EQ(a.stats.steps, b.stats.steps);
+  EXPECT_FALSE(a.stats.shortcuts_simulated_again);
+  EXPECT_LT(a.stats.simulated_ticks, b.stats.simulated_ticks);
+  for (const ExecutableTrajectory* e : {&a, &b}) {
+    EXPECT_FALSE(e->stats.fell_back);
+    EXPECT_EQ(resimulate_segments(*o.sim, *e, p.start), "");
+    EXPECT_EQ(checker_verdict(*o.sim, e->trajectory), "");
+    expect_at_rest_ends(*o.sim, *e, p);
+  }
+}
+
+// When a segment with a looked shortcut cannot be made valid, both passes run again with every
+// shortcut simulated first: the trajectory is the one those passes give on their own. Here an
+// end tolerance of 5e-4 rad, which the fixture's start-to-goal shortcut misses after its two
+// corrections where the blended raw steps land (a tolerance that also fails those falls back to
+// the raw chain in both).
+TEST(Execution, AFailedLookedShortcutRunsThePassesAgainWithSimulations) {
+  const Fixture& f = fixture();
+  const PathCase& c = long_path();
+  ASSERT_TRUE(c.result.success) << c.result.failure;
+  ExecutionOptions looked = options(true, true);
+  looked.end_tolerance = 5e-4;
+  ExecutionOptions simulated = looked;
+  simulated.looked_shortcuts = false;
+  const ExecutableTrajectory a = execute(f.sim, c, looked);
+  const ExecutableTrajectory b = execute(f.sim, c, simulated);
+  EXPECT_TRUE(a.stats.shortcuts_simulated_again);
+  EXPECT_FALSE(b.stats.shortcuts_simulated_again);
+  EXPECT_GT(a.stats.simulations, b.stats.simulations);
+  EXPECT_EQ(a.stats.shortcuts, b.stats.shortcuts);
+  EXPECT_EQ(a.stats.stops, b.stats.stops);
+  EXPECT_TRUE(a.trajectory.q == b.trajectory.q && a.trajectory.dq == b.trajectory.dq &&
+              a.trajectory.cmd == b.trajectory.cmd);
+  EXPECT_EQ(resimulate_segments(f.sim, a, c.problem.start), "");
+  EXPECT_EQ(checker_verdict(f.sim, a.trajectory), "");
+}
+
 // lazysp (with precheck, its default) looks at the straight command's line first: where the
 // line is blocked it spends no simulation on it, where precheck is off it simulates it. A budget
 // that has ended when the search would begin leaves only that attempt to count.

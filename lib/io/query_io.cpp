@@ -268,7 +268,8 @@ nlohmann::json execution_json(const ExecutionStats& e) {
           {"junctions", e.junctions},         {"blends_kept", e.blends_kept},
           {"simulations", e.simulations},     {"simulated_ticks", e.simulated_ticks},
           {"resumed_ticks", e.resumed_ticks}, {"seconds", e.seconds},
-          {"raw_seconds", e.raw_seconds},     {"fell_back", e.fell_back}};
+          {"raw_seconds", e.raw_seconds},     {"fell_back", e.fell_back},
+          {"shortcuts_simulated_again", e.shortcuts_simulated_again}};
 }
 
 nlohmann::json trajectory_json(const Trajectory& traj) {

@@ -216,7 +216,8 @@ RolloutResult simulate_to_target(Work& w, const JointVectorRef& q0, std::vector<
     if (!r.valid() || round >= w.options.max_corrections) return r;
     const JointVector residual = target - r.qf;
     if (residual.cwiseAbs().maxCoeff() <= w.options.correction_tolerance) return r;
-    correct_command(times, knots, first, last, residual);
+    const int late = w.options.correction_knots;
+    correct_command(times, knots, late > 0 ? std::max(first, last - late) : first, last, residual);
   }
 }
 
@@ -313,6 +314,11 @@ std::vector<Step> shortcut_steps(Work& w, const RawChain& raw, std::vector<Step>
         continue;
       }
       ++attempts;
+      if (w.options.look && w.options.looked_shortcuts) {
+        if (!((to - from).norm() < run_cost)) continue;  // a straight line: its length
+        accepted = j;
+        break;
+      }
       const int last = static_cast<int>(direct.times.size()) - 1;
       const RolloutResult r = simulate_to_target(w, from, direct.times, direct.knots, 1, last, to,
                                                  JointVector::Zero(to.size()), j + 1 == m);
@@ -329,8 +335,8 @@ std::vector<Step> shortcut_steps(Work& w, const RawChain& raw, std::vector<Step>
       ++i;
       continue;
     }
-    direct.simulated = true;
-    direct.trail = w.trail;  // of the accepted simulation, the last one made
+    direct.simulated = !(w.options.look && w.options.looked_shortcuts);
+    if (direct.simulated) direct.trail = w.trail;  // of the accepted simulation, the last made
     direct.target = raw.states[accepted + 1];
     direct.first_raw = i;
     direct.last_raw = accepted;
@@ -469,6 +475,13 @@ std::vector<double> junction_scales(const Work& w, const std::vector<Step>& step
   return scale;
 }
 
+// Whether steps [a, b] hold a shortcut taken on its look alone (ExecutionOptions::looked_shortcuts).
+bool looked_shortcut_in(const std::vector<Step>& steps, int a, int b) {
+  for (int k = a; k <= b; ++k)
+    if (steps[k].first_raw != steps[k].last_raw && !steps[k].simulated) return true;
+  return false;
+}
+
 // Blend pass: segments from the left, each as long as its blends allow; a failing junction is
 // first tried again with its longest blend, then split into a stop. False when a single step
 // cannot be simulated from where the previous segment ended (the caller falls back to the
@@ -488,7 +501,7 @@ bool blend_segments(Work& w, const std::vector<Step>& steps, const RawChain& raw
     for (;;) {
       const Attempt at = try_segment(w, steps, raw, a, b, scale, q0, goal, seg);
       if (at.ok) break;
-      if (at.junction < 0) return false;
+      if (at.junction < 0 || looked_shortcut_in(steps, a, b)) return false;
       const double longest = w.options.blend_scales.back();
       if (!retried[at.junction] && scale[at.junction] < longest) {
         retried[at.junction] = true;
@@ -539,6 +552,35 @@ Trajectory assemble(const Simulator& sim, const std::vector<ExecutionSegment>& s
 
 }  // namespace
 
+namespace {
+
+// The shortcut and blend passes; when a segment with a looked shortcut (not simulated on its own)
+// cannot be made valid, both again with the shortcuts simulated. False as blend_segments.
+bool shorten_and_blend(Work& w, const std::vector<PathStep>& steps, const RawChain& raw,
+                       const JointVectorRef& start, const Goal& goal,
+                       std::vector<ExecutionSegment>& segments, std::vector<double>& rows,
+                       std::vector<size_t>& segment_rows) {
+  const int n = w.sim.robot.dof;
+  std::vector<Step> work = raw_steps(steps, raw, n);
+  if (w.options.shortcut_attempts > 0) work = shortcut_steps(w, raw, std::move(work), goal);
+  w.stats.steps = static_cast<int>(work.size());
+  w.stats.junctions = w.stats.steps - 1;
+  if (blend_segments(w, work, raw, start, goal, segments, rows, segment_rows)) return true;
+  if (!(w.options.shortcut_attempts > 0 && w.options.look && w.options.looked_shortcuts))
+    return false;
+  ExecutionOptions simulated = w.options;
+  simulated.looked_shortcuts = false;
+  Work again{w.sim, w.final_sim, w.ws, simulated, w.stats, {}};
+  w.stats.shortcuts = 0;
+  w.stats.shortcuts_simulated_again = true;
+  segments.clear();
+  rows.clear();
+  segment_rows.clear();
+  return shorten_and_blend(again, steps, raw, start, goal, segments, rows, segment_rows);
+}
+
+}  // namespace
+
 ExecutableTrajectory make_executable(const Simulator& sim, SimulatorWorkspace& ws,
                                      const JointVectorRef& start,
                                      const std::vector<PathStep>& steps, const Goal& goal,
@@ -557,13 +599,9 @@ ExecutableTrajectory make_executable(const Simulator& sim, SimulatorWorkspace& w
   for (double c : raw.cost) st.raw_cost += c;
   st.raw_stops = st.raw_steps - 1;
 
-  std::vector<Step> work = raw_steps(steps, raw, sim.robot.dof);
-  if (options.shortcut_attempts > 0) work = shortcut_steps(w, raw, std::move(work), goal);
-  st.steps = static_cast<int>(work.size());
-  st.junctions = st.steps - 1;
   std::vector<double> rows;
   std::vector<size_t> segment_rows;
-  if (blend_segments(w, work, raw, start, goal, out.segments, rows, segment_rows)) {
+  if (shorten_and_blend(w, steps, raw, start, goal, out.segments, rows, segment_rows)) {
     out.trajectory = assemble(sim, out.segments, rows, segment_rows, std::max(1, sample_every));
     st.stops = out.trajectory.stops;
     st.blends_kept = st.junctions - st.stops;

@@ -35,6 +35,10 @@ struct ExecutionOptions {
   int max_corrections = 2;             // re-simulations to correct a segment's end offset
   double correction_tolerance = 2e-3;  // rad (max norm): no correction below this end offset
   double end_tolerance = 0.01;         // rad: a segment may end this far from the raw chain
+  // A correction round adds the residual to the last this many knots of the corrected range
+  // only (0: the whole range, evenly), so that it goes on from the rollout's checkpoint before
+  // them instead of simulating the range again.
+  int correction_knots = 1;
   // A rollout goes on from an earlier one's checkpoint where their commands agree (false: every
   // rollout from its start; the same trajectories, for comparing).
   bool resume = true;
@@ -47,6 +51,11 @@ struct ExecutionOptions {
   // one attempt of the budget (false: every candidate simulated, the trajectories as before the
   // look).
   bool look = true;
+  // With the look: a candidate whose line looks free and is shorter than the run it replaces is
+  // taken without a simulation of its own; the blend pass simulates it as the first part of its
+  // segment (its end offset corrected there with the segment's). When a segment then cannot be
+  // made valid, the shortcut pass runs again with simulations (false: always so).
+  bool looked_shortcuts = true;
   // A blocked look costs about 20-50 checked states, a simulation hundreds of ticks; the budget
   // still bounds the looks of a long path (m steps have about m^2 / 2 candidates).
   static constexpr int kLooksPerAttempt = 4;
@@ -85,6 +94,9 @@ struct ExecutionStats {
   double raw_seconds =
       0;  // of which the raw chain (re-simulating steps the planner did not hand over)
   bool fell_back = false;  // the raw chain is returned as it is
+  // A segment with a looked shortcut could not be made valid: both passes ran again with every
+  // shortcut simulated on its own (ExecutionOptions::looked_shortcuts).
+  bool shortcuts_simulated_again = false;
   double raw_duration = 0, raw_cost = 0;
   int raw_stops = 0;
 
