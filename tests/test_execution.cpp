@@ -589,6 +589,32 @@ TEST(Execution, ACorrectionRoundGoesOnFromBeforeTheLastKnot) {
   }
 }
 
+// A round that a correction may follow stops where its command ends, and the settle's
+// displacement is predicted (predict_settle): only a round whose predicted end needs no
+// correction settles. Fewer ticks than settling every round, the same shortcuts and stops, and
+// trajectories that pass re-simulation and the independent checker, at rest in the goal.
+TEST(Execution, ARoundThatACorrectionFollowsDoesNotSettle) {
+  const Fixture& f = fixture();
+  const PathCase& c = long_path();
+  ASSERT_TRUE(c.result.success) << c.result.failure;
+  for (bool shortcut : {false, true}) {
+    SCOPED_TRACE(shortcut ? "shortcuts and blends" : "blends");
+    ExecutionOptions predicted = options(shortcut, true), settled = predicted;
+    settled.predict_settle = false;
+    const ExecutableTrajectory a = execute(f.sim, c, predicted);
+    const ExecutableTrajectory b = execute(f.sim, c, settled);
+    EXPECT_LT(a.stats.simulated_ticks, b.stats.simulated_ticks);
+    EXPECT_EQ(a.stats.shortcuts, b.stats.shortcuts);
+    EXPECT_EQ(a.stats.stops, b.stats.stops);
+    for (const ExecutableTrajectory* e : {&a, &b}) {
+      EXPECT_FALSE(e->stats.fell_back);
+      EXPECT_EQ(resimulate_segments(f.sim, *e, c.problem.start), "");
+      EXPECT_EQ(checker_verdict(f.sim, e->trajectory), "");
+      expect_at_rest_ends(f.sim, *e, c.problem);
+    }
+  }
+}
+
 // A shortcut whose line looks free is taken without a simulation of its own: the blend pass
 // simulates it as the first part of its segment. The same shortcuts, fewer ticks than simulating
 // each shortcut first, and a trajectory that passes re-simulation and the independent checker.

@@ -282,6 +282,43 @@ TEST(Simulator, ARolloutResumedFromACheckpointIsTheFullRollout) {
   }
 }
 
+// A rollout stopped where its command ends (RolloutResume::stop_at, after the checkpoint due
+// there) is valid so far and `stopped`, at that tick; going on from that checkpoint gives the
+// full rollout bit for bit (the settle the post-processing predicts before it simulates it).
+TEST(Simulator, ARolloutStoppedAtATickGoesOnToTheFullRollout) {
+  Scene scene("table");
+  SimulatorWorkspace ws(scene.sim);
+  const BuildSettings settings = default_settings(scene.robot);
+  int compared = 0;
+  for (uint64_t a = 0; a < 20; ++a) {
+    SCOPED_TRACE("attempt " + std::to_string(a));
+    EdgeAttempt e;
+    generate_edge(scene.sim, ws, settings, a, e);
+    if (!e.valid()) continue;
+    const int end = ticks_before(scene.sim, e.command_duration);
+    const std::vector<int> save_at = {end};
+    std::vector<RolloutCheckpoint> saved;
+    std::vector<double> rows, full_rows;
+    const RolloutResult part = simulate(scene.sim, ws, e.q0, view(e, 7),
+                                        {nullptr, nullptr, 0, &rows}, {nullptr, &save_at, &saved, end});
+    EXPECT_TRUE(part.valid() && part.stopped);
+    EXPECT_EQ(part.ticks, end);
+    ASSERT_EQ(saved.size(), 1u);
+    EXPECT_EQ(part.qf, saved[0].q);
+    const RolloutResult full = simulate(scene.sim, ws, e.q0, view(e, 7), {nullptr, nullptr, 0, &full_rows});
+    const RolloutResult rest =
+        simulate(scene.sim, ws, e.q0, view(e, 7), {nullptr, nullptr, 0, &rows}, {&saved[0]});
+    EXPECT_FALSE(full.stopped || rest.stopped);
+    EXPECT_EQ(rest.status, full.status);
+    EXPECT_EQ(rest.qf, full.qf);
+    EXPECT_EQ(rest.ticks, full.ticks);
+    EXPECT_EQ(rest.collision_checks, full.collision_checks);
+    EXPECT_EQ(rows, full_rows);
+    ++compared;
+  }
+  EXPECT_GT(compared, 10);
+}
+
 TEST(Simulator, ViolationsAreCaught) {
   // Into the table: a start right above it and a command driving joint 2 forward.
   Scene scene("table");

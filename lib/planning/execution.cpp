@@ -158,9 +158,10 @@ const RolloutCheckpoint* resume_point(const Trail& t, const Simulator& sim,
 
 // Simulates a command from rest at q0, going on from the latest checkpoint of the last rollout
 // or of `also` that it agrees with; it becomes the last rollout (w.trail, its rows included).
+// With stop_at >= 0 it stops at that tick (a knot's: its checkpoint is the trail's last).
 RolloutResult rollout(Work& w, const Simulator& sim, const JointVectorRef& q0,
                       const std::vector<double>& times, const std::vector<double>& knots,
-                      bool uniform, const Trail* also) {
+                      bool uniform, const Trail* also, int stop_at = -1) {
   const bool resume = w.options.resume;
   const Trail* source = &w.trail;
   const RolloutCheckpoint* from =
@@ -178,7 +179,7 @@ RolloutResult rollout(Work& w, const Simulator& sim, const JointVectorRef& q0,
   next.knots = knots;
   next.uniform = uniform;
   next.knot_ticks.clear();
-  if (resume)
+  if (resume || stop_at >= 0)  // a stopped rollout's checkpoint is where it is gone on from
     for (size_t k = 1; k < times.size(); ++k)
       next.knot_ticks.push_back(ticks_before(sim, times[k]));
   next.checkpoints.clear();
@@ -191,10 +192,27 @@ RolloutResult rollout(Work& w, const Simulator& sim, const JointVectorRef& q0,
   const CommandProfile p{knots.data(), static_cast<int>(times.size()), sim.robot.dof, times.back(),
                          uniform ? nullptr : times.data()};
   const RolloutResult r = simulate(sim, w.ws, q0, p, {nullptr, nullptr, 0, &next.rows},
-                                   {from, &next.knot_ticks, &next.checkpoints});
+                                   {from, &next.knot_ticks, &next.checkpoints, stop_at});
   w.stats.count(r, from ? from->tick : 0);
   std::swap(w.trail, w.spare);
   return r;
+}
+
+// After a command ends the controller applies g(q) + kv (0 - dq), and the friction brakes too:
+// with M about constant over the settle's small motion, integrating M ddq = -(K_v + F) dq from dq
+// to rest gives the displacement still to come, (K_v + F)^-1 M dq (F: the friction's slope at
+// rest; C(q, dq) dq is second order in the small dq).
+JointVector settle_displacement(const Simulator& sim, RobotData& data, const JointVector& q,
+                                const JointVector& dq) {
+  const RobotModel& robot = sim.robot;
+  JointVector out = mass_matrix(robot, data, q) * dq;
+  constexpr double kStep = 1e-6;  // rad/s: the slope by a central difference
+  for (int i = 0; i < robot.dof; ++i) {
+    const Friction& f = robot.joints[i].friction;
+    const double slope = (friction_torque(f, kStep) - friction_torque(f, -kStep)) / (2 * kStep);
+    out[i] /= robot.controller.kv[i] + slope;
+  }
+  return out;
 }
 
 // Simulates a command from rest at q0 (a rollout); corrects its end offset from `target`
@@ -211,13 +229,32 @@ RolloutResult simulate_to_target(Work& w, const JointVectorRef& q0, std::vector<
   const Simulator& sim = ends_trajectory ? w.final_sim : w.sim;
   if (predicted_offset.cwiseAbs().maxCoeff() > 0)
     correct_command(times, knots, first, last, -predicted_offset);
+  const int late = w.options.correction_knots;
+  const int from = late > 0 ? std::max(first, last - late) : first;
   for (int round = 0;; ++round) {
+    // A round that a correction may follow stops where the command ends; the settle's
+    // displacement is predicted, and only a round whose predicted end needs no correction
+    // settles (going on from there).
+    if (w.options.predict_settle && round < w.options.max_corrections) {
+      const RolloutResult part =
+          rollout(w, sim, q0, times, knots, uniform, also, ticks_before(sim, times.back()));
+      if (!part.valid()) return part;
+      const std::vector<RolloutCheckpoint>& saved = w.trail.checkpoints;
+      if (part.stopped && !saved.empty() && saved.back().tick == part.ticks) {
+        const RolloutCheckpoint& end = saved.back();
+        const JointVector residual =
+            target - end.q - settle_displacement(sim, w.ws.robot, end.q, end.dq);
+        if (residual.cwiseAbs().maxCoeff() > w.options.correction_tolerance) {
+          correct_command(times, knots, from, last, residual);
+          continue;
+        }
+      }
+    }
     const RolloutResult r = rollout(w, sim, q0, times, knots, uniform, also);
     if (!r.valid() || round >= w.options.max_corrections) return r;
     const JointVector residual = target - r.qf;
     if (residual.cwiseAbs().maxCoeff() <= w.options.correction_tolerance) return r;
-    const int late = w.options.correction_knots;
-    correct_command(times, knots, late > 0 ? std::max(first, last - late) : first, last, residual);
+    correct_command(times, knots, from, last, residual);
   }
 }
 

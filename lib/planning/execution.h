@@ -39,6 +39,11 @@ struct ExecutionOptions {
   // only (0: the whole range, evenly), so that it goes on from the rollout's checkpoint before
   // them instead of simulating the range again.
   int correction_knots = 1;
+  // A rollout that a correction may follow stops where its command ends; the settle's
+  // displacement is predicted from that state (settle_displacement), and only when the predicted
+  // end needs no correction is the settle simulated (going on from there). False: every round
+  // settles and its real end decides.
+  bool predict_settle = true;
   // A rollout goes on from an earlier one's checkpoint where their commands agree (false: every
   // rollout from its start; the same trajectories, for comparing).
   bool resume = true;

@@ -444,6 +444,10 @@ RolloutResult simulate(const Simulator& sim, SimulatorWorkspace& ws, const Joint
   CheckpointSaver saver(resume, first_tick);
   for (int tick = first_tick; tick < max_ticks; ++tick) {
     if (saver.due(tick)) saver.save(s, result, tick, end_effector.velocity(), samples);
+    if (tick == resume.stop_at) {
+      result.stopped = true;
+      return finish(RolloutStatus::Valid, tick);
+    }
     const double t = tick * dt;
     evaluate_command(profile, t, v_cmd.data(), a_cmd.data(), nullptr);
 

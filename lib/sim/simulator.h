@@ -100,6 +100,7 @@ struct RolloutResult {
   int ticks = 0;        // control ticks simulated
   int collision_checks = 0;
   double path_length = 0;  // arc length of the motion in joint space, rad
+  bool stopped = false;    // at RolloutResume::stop_at (valid so far, not at rest)
   bool valid() const { return status == RolloutStatus::Valid; }
 };
 
@@ -135,6 +136,9 @@ struct RolloutResume {
   const RolloutCheckpoint* from = nullptr;
   const std::vector<int>* save_at = nullptr;
   std::vector<RolloutCheckpoint>* saved = nullptr;
+  // A tick to stop at, after saving a checkpoint due there (-1: none): the result is then
+  // `stopped`, valid so far but not at rest; going on from that checkpoint gives the rest.
+  int stop_at = -1;
 };
 
 // Whether rollouts of `a` and `b` agree tick for tick until their command ends: the same robot,
