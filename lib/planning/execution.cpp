@@ -215,12 +215,12 @@ JointVector settle_displacement(const Simulator& sim, RobotData& data, const Joi
   return out;
 }
 
-// Simulates a command from rest at q0 (a rollout); corrects its end offset from `target`
-// (knots [first, last) carry the correction) up to max_corrections times. `offset` is the
-// predicted end offset before any simulation (the start's offset from the raw chain).
-// `uniform`: the knots are evenly spaced, simulated as such (a raw step alone is then its own
-// bundle command, bit for bit). A correction round goes on from where it changes the command
-// when that is after the command's second knot (a joined command's last step).
+// Simulates a command from rest at q0 (a rollout); corrects its end offset from `target` up to
+// max_corrections times. `offset` is the predicted end offset before any simulation (the
+// start's offset from the raw chain), spread over knots [first, last); a measured one goes into
+// the last correction_knots of them. `uniform`: the knots are evenly spaced, simulated as such
+// (a raw step alone is then its own bundle command, bit for bit). A correction round goes on
+// from where it changes the command (its checkpoint before the corrected knots).
 RolloutResult simulate_to_target(Work& w, const JointVectorRef& q0, std::vector<double>& times,
                                  std::vector<double>& knots, int first, int last,
                                  const JointVector& target, const JointVector& predicted_offset,
@@ -586,10 +586,6 @@ Trajectory assemble(const Simulator& sim, const std::vector<ExecutionSegment>& s
   t.stops = static_cast<int>(segments.size()) - 1;
   return t;
 }
-
-}  // namespace
-
-namespace {
 
 // The shortcut and blend passes; when a segment with a looked shortcut (not simulated on its own)
 // cannot be made valid, both again with the shortcuts simulated. False as blend_segments.
