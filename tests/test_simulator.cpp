@@ -299,13 +299,15 @@ TEST(Simulator, ARolloutStoppedAtATickGoesOnToTheFullRollout) {
     const std::vector<int> save_at = {end};
     std::vector<RolloutCheckpoint> saved;
     std::vector<double> rows, full_rows;
-    const RolloutResult part = simulate(scene.sim, ws, e.q0, view(e, 7),
-                                        {nullptr, nullptr, 0, &rows}, {nullptr, &save_at, &saved, end});
+    const RolloutResult part =
+        simulate(scene.sim, ws, e.q0, view(e, 7), {nullptr, nullptr, 0, &rows},
+                 {nullptr, &save_at, &saved, end});
     EXPECT_TRUE(part.valid() && part.stopped);
     EXPECT_EQ(part.ticks, end);
     ASSERT_EQ(saved.size(), 1u);
     EXPECT_EQ(part.qf, saved[0].q);
-    const RolloutResult full = simulate(scene.sim, ws, e.q0, view(e, 7), {nullptr, nullptr, 0, &full_rows});
+    const RolloutResult full =
+        simulate(scene.sim, ws, e.q0, view(e, 7), {nullptr, nullptr, 0, &full_rows});
     const RolloutResult rest =
         simulate(scene.sim, ws, e.q0, view(e, 7), {nullptr, nullptr, 0, &rows}, {&saved[0]});
     EXPECT_FALSE(full.stopped || rest.stopped);

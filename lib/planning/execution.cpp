@@ -17,8 +17,8 @@ constexpr double kJunctionRoom = 0.7;
 
 // A rollout of this stage, kept with checkpoints at its knots, so that a later command from
 // the same start that agrees with it up to some knot goes on from there rather than being
-// simulated again (issue 27): a correction round of a joined command (one of a single step
-// changes it from its first knot on: simulated again), a junction tried again or split into a
+// simulated again (issue 27): a correction round (it changes the last interior knot), the
+// settle of a rollout stopped where its command ends, a junction tried again or split into a
 // stop, a segment that begins with a shortcut's simulated command.
 struct Trail {
   const Simulator* sim = nullptr;
@@ -28,6 +28,7 @@ struct Trail {
   std::vector<int> knot_ticks;                 // ticks_before(times[k]), k >= 1
   std::vector<RolloutCheckpoint> checkpoints;  // at those ticks the rollout got to
   std::vector<double> rows;                    // its per-tick rows
+  int stopped_at = -1;  // the tick it stopped at (RolloutResume::stop_at), or -1
 };
 
 // A step of the path being processed: its command with knot times, and the raw chain's state
@@ -60,6 +61,7 @@ struct Work {
   ExecutionStats& stats;
   Trail trail = {};  // the last rollout made or reused (its rows: the segment's per-tick rows)
   Trail spare = {};  // scratch for the next one
+  bool looked_shortcut_failed = false;  // blend_segments gave up on a looked shortcut's segment
 };
 
 bool within_limits(const RobotModel& robot, const CommandSampling& limits, int joint, double dv,
@@ -164,8 +166,11 @@ RolloutResult rollout(Work& w, const Simulator& sim, const JointVectorRef& q0,
                       bool uniform, const Trail* also, int stop_at = -1) {
   const bool resume = w.options.resume;
   const Trail* source = &w.trail;
-  const RolloutCheckpoint* from =
-      resume ? resume_point(w.trail, sim, q0, times, knots, uniform) : nullptr;
+  const RolloutCheckpoint* from = resume || w.trail.stopped_at >= 0
+                                      ? resume_point(w.trail, sim, q0, times, knots, uniform)
+                                      : nullptr;
+  // Without resume, only the rollout that stopped where its command ends is finished from there.
+  if (!resume && from && from->tick != w.trail.stopped_at) from = nullptr;
   const RolloutCheckpoint* other =
       resume && also ? resume_point(*also, sim, q0, times, knots, uniform) : nullptr;
   if (other && (!from || other->tick > from->tick)) {
@@ -191,28 +196,17 @@ RolloutResult rollout(Work& w, const Simulator& sim, const JointVectorRef& q0,
   }
   const CommandProfile p{knots.data(), static_cast<int>(times.size()), sim.robot.dof, times.back(),
                          uniform ? nullptr : times.data()};
+  // Going on from where the last rollout stopped finishes that rollout: one simulation.
+  const bool finishes = from && source == &w.trail && from->tick == w.trail.stopped_at;
   const RolloutResult r = simulate(sim, w.ws, q0, p, {nullptr, nullptr, 0, &next.rows},
                                    {from, &next.knot_ticks, &next.checkpoints, stop_at});
-  w.stats.count(r, from ? from->tick : 0);
+  next.stopped_at = r.stopped ? r.ticks : -1;
+  if (finishes)
+    w.stats.simulated_ticks += r.ticks - from->tick;
+  else
+    w.stats.count(r, from ? from->tick : 0);
   std::swap(w.trail, w.spare);
   return r;
-}
-
-// After a command ends the controller applies g(q) + kv (0 - dq), and the friction brakes too:
-// with M about constant over the settle's small motion, integrating M ddq = -(K_v + F) dq from dq
-// to rest gives the displacement still to come, (K_v + F)^-1 M dq (F: the friction's slope at
-// rest; C(q, dq) dq is second order in the small dq).
-JointVector settle_displacement(const Simulator& sim, RobotData& data, const JointVector& q,
-                                const JointVector& dq) {
-  const RobotModel& robot = sim.robot;
-  JointVector out = mass_matrix(robot, data, q) * dq;
-  constexpr double kStep = 1e-6;  // rad/s: the slope by a central difference
-  for (int i = 0; i < robot.dof; ++i) {
-    const Friction& f = robot.joints[i].friction;
-    const double slope = (friction_torque(f, kStep) - friction_torque(f, -kStep)) / (2 * kStep);
-    out[i] /= robot.controller.kv[i] + slope;
-  }
-  return out;
 }
 
 // Simulates a command from rest at q0 (a rollout); corrects its end offset from `target` up to
@@ -283,6 +277,19 @@ Trajectory returned_trajectory(const Simulator& sim, SimulatorWorkspace& ws,
   return std::move(e.trajectory);
 }
 
+JointVector settle_displacement(const Simulator& sim, RobotData& data, const JointVector& q,
+                                const JointVector& dq) {
+  const RobotModel& robot = sim.robot;
+  JointVector out = mass_matrix(robot, data, q) * dq;
+  constexpr double kStep = 1e-6;  // rad/s: the slope by a central difference
+  for (int i = 0; i < robot.dof; ++i) {
+    const Friction& f = robot.joints[i].friction;
+    const double slope = (friction_torque(f, kStep) - friction_torque(f, -kStep)) / (2 * kStep);
+    out[i] /= robot.controller.kv[i] + slope;
+  }
+  return out;
+}
+
 Simulator execution_simulator(const Simulator& sim) {
   Simulator stopping = sim;
   stopping.options.settle_for_stop = true;
@@ -326,7 +333,8 @@ namespace {
 
 // Shortcut pass: from each step, the farthest later state reachable by one direct command
 // that simulates valid from the raw chain's state, lands near that state (inside the goal for
-// the last) and is shorter than the run it replaces.
+// the last) and is shorter than the run it replaces; with looked_shortcuts, the first whose
+// line looks free and is shorter, unsimulated (the blend pass simulates it in its segment).
 std::vector<Step> shortcut_steps(Work& w, const RawChain& raw, std::vector<Step> steps,
                                  const Goal& goal) {
   const int m = static_cast<int>(steps.size());
@@ -512,7 +520,8 @@ std::vector<double> junction_scales(const Work& w, const std::vector<Step>& step
   return scale;
 }
 
-// Whether steps [a, b] hold a shortcut taken on its look alone (ExecutionOptions::looked_shortcuts).
+// Whether steps [a, b] hold a shortcut taken on its look alone
+// (ExecutionOptions::looked_shortcuts).
 bool looked_shortcut_in(const std::vector<Step>& steps, int a, int b) {
   for (int k = a; k <= b; ++k)
     if (steps[k].first_raw != steps[k].last_raw && !steps[k].simulated) return true;
@@ -521,8 +530,9 @@ bool looked_shortcut_in(const std::vector<Step>& steps, int a, int b) {
 
 // Blend pass: segments from the left, each as long as its blends allow; a failing junction is
 // first tried again with its longest blend, then split into a stop. False when a single step
-// cannot be simulated from where the previous segment ended (the caller falls back to the
-// raw chain).
+// cannot be simulated from where the previous segment ended, or at the first failed attempt
+// of a segment holding a looked shortcut (w.looked_shortcut_failed; the caller runs the passes
+// again with simulated shortcuts, or falls back to the raw chain).
 bool blend_segments(Work& w, const std::vector<Step>& steps, const RawChain& raw,
                     const JointVectorRef& start, const Goal& goal,
                     std::vector<ExecutionSegment>& segments, std::vector<double>& tick_rows,
@@ -538,7 +548,11 @@ bool blend_segments(Work& w, const std::vector<Step>& steps, const RawChain& raw
     for (;;) {
       const Attempt at = try_segment(w, steps, raw, a, b, scale, q0, goal, seg);
       if (at.ok) break;
-      if (at.junction < 0 || looked_shortcut_in(steps, a, b)) return false;
+      if (looked_shortcut_in(steps, a, b)) {
+        w.looked_shortcut_failed = true;
+        return false;
+      }
+      if (at.junction < 0) return false;
       const double longest = w.options.blend_scales.back();
       if (!retried[at.junction] && scale[at.junction] < longest) {
         retried[at.junction] = true;
@@ -594,17 +608,18 @@ bool shorten_and_blend(Work& w, const std::vector<PathStep>& steps, const RawCha
                        std::vector<ExecutionSegment>& segments, std::vector<double>& rows,
                        std::vector<size_t>& segment_rows) {
   const int n = w.sim.robot.dof;
+  const int looked_blocked = w.stats.looked_blocked;  // the shortcut budget counts from here
   std::vector<Step> work = raw_steps(steps, raw, n);
   if (w.options.shortcut_attempts > 0) work = shortcut_steps(w, raw, std::move(work), goal);
   w.stats.steps = static_cast<int>(work.size());
   w.stats.junctions = w.stats.steps - 1;
   if (blend_segments(w, work, raw, start, goal, segments, rows, segment_rows)) return true;
-  if (!(w.options.shortcut_attempts > 0 && w.options.look && w.options.looked_shortcuts))
-    return false;
+  if (!w.looked_shortcut_failed) return false;
   ExecutionOptions simulated = w.options;
   simulated.looked_shortcuts = false;
   Work again{w.sim, w.final_sim, w.ws, simulated, w.stats, {}};
   w.stats.shortcuts = 0;
+  w.stats.looked_blocked = looked_blocked;  // the passes again, as if they ran alone
   w.stats.shortcuts_simulated_again = true;
   segments.clear();
   rows.clear();

@@ -41,8 +41,10 @@ struct ExecutionOptions {
   int correction_knots = 1;
   // A rollout that a correction may follow stops where its command ends; the settle's
   // displacement is predicted from that state (settle_displacement), and only when the predicted
-  // end needs no correction is the settle simulated (going on from there). False: every round
-  // settles and its real end decides.
+  // end needs no correction is the settle simulated (going on from there, also with resume
+  // false: the same rollout finished). A corrected round's end is then predicted, not measured;
+  // the end the segment keeps is always simulated and checked. False: every round settles and
+  // its real end decides.
   bool predict_settle = true;
   // A rollout goes on from an earlier one's checkpoint where their commands agree (false: every
   // rollout from its start; the same trajectories, for comparing).
@@ -57,9 +59,9 @@ struct ExecutionOptions {
   // look).
   bool look = true;
   // With the look: a candidate whose line looks free and is shorter than the run it replaces is
-  // taken without a simulation of its own; the blend pass simulates it as the first part of its
-  // segment (its end offset corrected there with the segment's). When a segment then cannot be
-  // made valid, the shortcut pass runs again with simulations (false: always so).
+  // taken without a simulation of its own; the blend pass simulates it as part of its segment
+  // (only the segment's end is corrected). At the first failed attempt of a segment holding
+  // one, both passes run again with every shortcut simulated on its own (false: always so).
   bool looked_shortcuts = true;
   // A blocked look costs about 20-50 checked states, a simulation hundreds of ticks; the budget
   // still bounds the looks of a long path (m steps have about m^2 / 2 candidates).
@@ -88,8 +90,9 @@ struct ExecutionStats {
   int junctions = 0;       // between the steps after shortcutting
   int blends_kept = 0;     // junctions passed without stopping
   int stops = 0;           // junctions kept at rest (= junctions - blends_kept)
-  int simulations =
-      0;  // rollouts simulated by this stage (raw steps the planner did not hand over included)
+  // Rollouts simulated by this stage (raw steps the planner did not hand over included; one
+  // stopped where its command ends and then finished counts once).
+  int simulations = 0;
   long simulated_ticks = 0;  // control ticks of those rollouts (not those a resumed one skipped)
   // Ticks not simulated again: a rollout whose command agrees with an earlier one's from the
   // same start up to a knot (a correction round, a junction tried again or split into a stop,
@@ -99,7 +102,7 @@ struct ExecutionStats {
   double raw_seconds =
       0;  // of which the raw chain (re-simulating steps the planner did not hand over)
   bool fell_back = false;  // the raw chain is returned as it is
-  // A segment with a looked shortcut could not be made valid: both passes ran again with every
+  // An attempt at a segment holding a looked shortcut failed: both passes ran again with every
   // shortcut simulated on its own (ExecutionOptions::looked_shortcuts).
   bool shortcuts_simulated_again = false;
   double raw_duration = 0, raw_cost = 0;
@@ -135,6 +138,13 @@ ExecutableTrajectory make_executable(const Simulator& sim, SimulatorWorkspace& w
 // to kExecutionSettleTime after the command.
 constexpr double kExecutionSettleTime = 3.0;  // s
 Simulator execution_simulator(const Simulator& sim);
+
+// The displacement still to come when a command ends at (q, dq) and the arm settles: the
+// controller holds g(q) + kv (0 - dq) and the friction brakes, so M ddq = -(K_v + F) dq
+// integrates, with M about constant over the settle's small motion, to (K_v + F)^-1 M dq (F: the
+// friction's slope at rest; C(q, dq) dq is second order in the small dq). `data`: scratch.
+JointVector settle_displacement(const Simulator& sim, RobotData& data, const JointVector& q,
+                                const JointVector& dq);
 
 // What answer_request (request.h) returns for a solved problem: the
 // executable trajectory, its figures in `stats`, or with `raw` the planner's edge chain as

@@ -95,7 +95,7 @@ struct SimulatorWorkspace {
 
 struct RolloutResult {
   RolloutStatus status = RolloutStatus::Valid;
-  JointVector qf;       // final state (at rest when valid)
+  JointVector qf;       // final state (at rest when valid and not stopped)
   double duration = 0;  // simulated time, s
   int ticks = 0;        // control ticks simulated
   int collision_checks = 0;
@@ -150,8 +150,8 @@ bool same_until_settling(const Simulator& a, const Simulator& b);
 // margin: a command changed from time t on leaves every earlier tick as it was.
 int ticks_before(const Simulator& sim, double t);
 
-// Simulates from rest at q0 (or on from resume.from). Stops at the first violation. Allocates
-// nothing when the sample vectors have capacity.
+// Simulates from rest at q0 (or on from resume.from). Stops at the first violation, or at
+// resume.stop_at (`stopped`). Allocates nothing when the sample vectors have capacity.
 RolloutResult simulate(const Simulator& sim, SimulatorWorkspace& ws, const JointVectorRef& q0,
                        const CommandProfile& profile, TrajectorySamples samples = {},
                        RolloutResume resume = {});
