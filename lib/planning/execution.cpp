@@ -601,8 +601,9 @@ Trajectory assemble(const Simulator& sim, const std::vector<ExecutionSegment>& s
   return t;
 }
 
-// The shortcut and blend passes; when a segment with a looked shortcut (not simulated on its own)
-// cannot be made valid, both again with the shortcuts simulated. False as blend_segments.
+// The shortcut and blend passes; when an attempt at a segment with a looked shortcut (not
+// simulated on its own) fails, both again with the shortcuts simulated. False as
+// blend_segments.
 bool shorten_and_blend(Work& w, const std::vector<PathStep>& steps, const RawChain& raw,
                        const JointVectorRef& start, const Goal& goal,
                        std::vector<ExecutionSegment>& segments, std::vector<double>& rows,
