@@ -152,6 +152,16 @@ void expect_at_rest_ends(const Simulator& sim, const ExecutableTrajectory& e,
   EXPECT_LE((t.q.back() - problem.goal.q).norm(), problem.goal.tolerance);
 }
 
+// An executable trajectory, not the raw chain, that passes re-simulation and the independent
+// checker and rests at both ends, the last in the goal.
+void expect_executable(const Simulator& sim, const ExecutableTrajectory& e,
+                       const PlanningProblem& problem) {
+  EXPECT_FALSE(e.stats.fell_back);
+  EXPECT_EQ(resimulate_segments(sim, e, problem.start), "");
+  EXPECT_EQ(checker_verdict(sim, e.trajectory), "");
+  expect_at_rest_ends(sim, e, problem);
+}
+
 TEST(Execution, BlendedTrajectoryPassesReSimulationAndReValidation) {
   const Fixture& f = fixture();
   const PathCase& c = long_path();
@@ -559,12 +569,7 @@ TEST(Execution, TheShortcutPassLooksBeforeItSimulates) {
   EXPECT_GE(with_look.stats.looked_blocked, 1);
   EXPECT_EQ(without.stats.looked_blocked, 0);
   EXPECT_LT(with_look.stats.simulations, without.stats.simulations);
-  for (const ExecutableTrajectory* e : {&with_look, &without}) {
-    EXPECT_FALSE(e->stats.fell_back);
-    EXPECT_EQ(resimulate_segments(*o.sim, *e, p.start), "");
-    EXPECT_EQ(checker_verdict(*o.sim, e->trajectory), "");
-    expect_at_rest_ends(*o.sim, *e, p);
-  }
+  for (const ExecutableTrajectory* e : {&with_look, &without}) expect_executable(*o.sim, *e, p);
 }
 
 // A correction round adds the residual to the last knot of the corrected range only
@@ -581,12 +586,7 @@ TEST(Execution, ACorrectionRoundGoesOnFromBeforeTheLastKnot) {
   const ExecutableTrajectory b = execute(f.sim, c, spread);
   EXPECT_GT(a.stats.resumed_ticks, b.stats.resumed_ticks);
   EXPECT_LT(a.stats.simulated_ticks, b.stats.simulated_ticks);
-  for (const ExecutableTrajectory* e : {&a, &b}) {
-    EXPECT_FALSE(e->stats.fell_back);
-    EXPECT_EQ(resimulate_segments(f.sim, *e, c.problem.start), "");
-    EXPECT_EQ(checker_verdict(f.sim, e->trajectory), "");
-    expect_at_rest_ends(f.sim, *e, c.problem);
-  }
+  for (const ExecutableTrajectory* e : {&a, &b}) expect_executable(f.sim, *e, c.problem);
 }
 
 // A round that a correction may follow stops where its command ends, and the settle's
@@ -606,12 +606,7 @@ TEST(Execution, ARoundThatACorrectionFollowsDoesNotSettle) {
     EXPECT_LT(a.stats.simulated_ticks, b.stats.simulated_ticks);
     EXPECT_EQ(a.stats.shortcuts, b.stats.shortcuts);
     EXPECT_EQ(a.stats.stops, b.stats.stops);
-    for (const ExecutableTrajectory* e : {&a, &b}) {
-      EXPECT_FALSE(e->stats.fell_back);
-      EXPECT_EQ(resimulate_segments(f.sim, *e, c.problem.start), "");
-      EXPECT_EQ(checker_verdict(f.sim, e->trajectory), "");
-      expect_at_rest_ends(f.sim, *e, c.problem);
-    }
+    for (const ExecutableTrajectory* e : {&a, &b}) expect_executable(f.sim, *e, c.problem);
   }
 }
 
@@ -667,15 +662,10 @@ TEST(Execution, ALookedShortcutIsSimulatedOnlyInItsSegment) {
   EXPECT_EQ(a.stats.steps, b.stats.steps);
   EXPECT_FALSE(a.stats.shortcuts_simulated_again);
   EXPECT_LT(a.stats.simulated_ticks, b.stats.simulated_ticks);
-  for (const ExecutableTrajectory* e : {&a, &b}) {
-    EXPECT_FALSE(e->stats.fell_back);
-    EXPECT_EQ(resimulate_segments(*o.sim, *e, p.start), "");
-    EXPECT_EQ(checker_verdict(*o.sim, e->trajectory), "");
-    expect_at_rest_ends(*o.sim, *e, p);
-  }
+  for (const ExecutableTrajectory* e : {&a, &b}) expect_executable(*o.sim, *e, p);
 }
 
-// When a segment with a looked shortcut cannot be made valid, both passes run again with every
+// When an attempt at a segment with a looked shortcut fails, both passes run again with every
 // shortcut simulated first: the trajectory is the one those passes give on their own. Here an
 // end tolerance of 5e-4 rad, which the fixture's start-to-goal shortcut misses after its two
 // corrections where the blended raw steps land (a tolerance that also fails those falls back to
