@@ -96,8 +96,9 @@ inline const std::vector<std::string> kPlanners = own_planners();
 bool is_bundle_planner(const std::string& planner);
 // `values` with direct = false for a planner that declares `direct`: tests of a search run the
 // search, not the straight command tried before it (tested on its own in test_execution); and
-// for lazysp connect_radius = 0 unless given (its paths then are of bundle edges and growth
-// commands only; the connection is tested on its own in test_planners).
+// for lazysp connect_radius = 0 and shortcut = 0 unless given (its paths then are of bundle
+// edges and growth commands only; the connection and the shortcut are tested on their own in
+// test_planners).
 ParameterValues searching(const std::string& planner, ParameterValues values = {});
 double easy_budget(const std::string& planner);  // of the easy problem a -> b
 

@@ -52,10 +52,11 @@ json query(const std::string& id, const JointVectorRef& start, const JointVector
   q["seed"] = seed;
   if (stop_at_first) q["stop_at_first"] = true;
   // The searches are what these tests check: not the straight command tried first, nor
-  // lazysp's direct command to the goal from a state near it.
+  // lazysp's direct command to the goal from a state near it, nor its shortcut of a candidate.
   const ParameterValues only_search = searching(planner);
   if (only_search.has("direct")) q["direct"] = false;
   if (only_search.has("connect_radius")) q["connect_radius"] = 0;
+  if (only_search.has("shortcut")) q["shortcut"] = false;
   return q;
 }
 

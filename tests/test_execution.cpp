@@ -8,9 +8,11 @@
 // do. The planners hand over their simulation of each step, so the raw chain is not simulated
 // again; the bundle planners answer a free straight command with it (found_by direct), a blocked
 // one by searching. Rollouts that go on from earlier ones' checkpoints change nothing but the
-// ticks simulated.
+// ticks simulated. Straight commands through points blended into one command with knot times
+// (lazysp's shortcut) are one rollout that the post-processing keeps as it is.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <memory>
@@ -732,6 +734,67 @@ TEST(Execution, DirectCommandIsAStraightLineWithinTheCommandLimits) {
     EXPECT_LE((a.array().abs() - o.limits.limit_scale * f.robot.ddq_max.array()).maxCoeff(), 1e-9);
   }
   EXPECT_FALSE(direct_command(f.robot, o.limits, JointVector::Zero(n), f.sim.dt, times, knots));
+}
+
+// Straight commands through points, their junction blended into one command with knot times
+// (lazysp's shortcut): one rollout, its rows handed over, so that the post-processing keeps it
+// without a simulation; shorter than the two commands from rest to rest.
+TEST(Execution, ABlendedStepThroughPointsIsOneSimulatedCommand) {
+  const Fixture& f = fixture();
+  const ExecutionOptions o = options(true, true);
+  PlanningProblem p = problem_to(f.a, f.b);
+  JointVector via = 0.5 * (f.a + f.b);
+  via[0] += 0.3;  // off the line a -> b: a corner to blend
+  SimulatorWorkspace ws(f.sim);
+  ASSERT_EQ(check_state(f.sim, ws, via), RolloutStatus::Valid);
+  int simulations = 0;
+  const std::optional<PathStep> step =
+      blended_step_through(f.sim, ws, o, {f.a, via, f.b}, p.goal, &simulations);
+  ASSERT_TRUE(step && step->outcome);
+  ASSERT_TRUE(solves(f.sim, ws, *step, p.goal)) << rollout_status_name(step->outcome->status);
+  EXPECT_GE(simulations, 1);
+  const std::vector<double>& times = step->knot_times;
+  ASSERT_EQ(times.size() * f.robot.dof, step->knots.size());
+  EXPECT_TRUE(std::is_sorted(times.begin(), times.end()));
+  EXPECT_EQ(times.back(), step->command_duration);
+  // The evenly spaced knots of the same command would be another command.
+  PathStep even = *step;
+  even.knot_times.clear();
+  EXPECT_NE(simulate(f.sim, ws, f.a, even.profile(f.robot.dof)).qf, step->outcome->qf);
+
+  // Its own rollout, tick for tick: the command with its times.
+  std::vector<double> rows;
+  const RolloutResult again =
+      simulate(f.sim, ws, f.a, step->profile(f.robot.dof), {nullptr, nullptr, 0, &rows});
+  EXPECT_EQ(again.qf, step->outcome->qf);
+  EXPECT_EQ(rows, step->outcome_rows);
+
+  // From rest to rest through `via`, within the junction room, it takes longer.
+  CommandSampling room = o.limits;
+  room.limit_scale *= kJunctionRoom;
+  Goal near_via;
+  near_via.q = via;
+  near_via.tolerance = 0.05;
+  const std::optional<PathStep> first = direct_step_to(f.sim, ws, room, f.a, via, &near_via);
+  ASSERT_TRUE(first && first->outcome->valid());
+  const std::optional<PathStep> second =
+      direct_step_to(f.sim, ws, room, first->outcome->qf, f.b, &p.goal);
+  ASSERT_TRUE(second && second->outcome->valid());
+  EXPECT_LT(step->outcome->duration, first->outcome->duration + second->outcome->duration);
+
+  // The post-processing keeps it as it is: nothing simulated.
+  const ExecutableTrajectory e = make_executable(f.sim, ws, p.start, {*step}, p.goal, o, 1);
+  EXPECT_EQ(e.stats.simulations, 0);
+  EXPECT_EQ(e.stats.simulated_ticks, 0);
+  ASSERT_EQ(e.segments.size(), 1u);
+  EXPECT_FALSE(e.segments[0].uniform);
+  expect_executable(f.sim, e, p);
+  // The raw chain simulates it with its times too.
+  const Trajectory raw = realize_path(f.sim, ws, p.start, {*step}, p.goal, 1);
+  EXPECT_EQ(raw.q.back(), step->outcome->qf);
+
+  // Coinciding points make no command.
+  EXPECT_FALSE(blended_step_through(f.sim, ws, o, {f.a, f.a, f.b}, p.goal));
 }
 
 TEST(Execution, KnotTimesEvaluateAsEvenSpacing) {

@@ -25,6 +25,7 @@
 #include "lazyboe/bundle/bundle.h"
 #include "lazyboe/bundle/bundle_view.h"
 #include "lazyboe/common/error.h"
+#include "lazyboe/planning/execution.h"
 #include "lazyboe/planning/neighbour_index.h"
 #include "lazyboe/planning/planners/bundle_search.h"
 #include "lazyboe/planning/planning_session.h"
@@ -279,8 +280,7 @@ TEST(Planners, OutputsAreMadeOfSimulatedEdgesOnly) {
     // the trajectory ends; for the bundle planners the edge ids name the same commands.
     std::vector<CommandProfile> commands;
     for (const PathStep& s : r.result.best_path) {
-      commands.push_back({s.knots.data(), static_cast<int>(s.knots.size() / f.robot.dof),
-                          f.robot.dof, s.command_duration});
+      commands.push_back(s.profile(f.robot.dof));
     }
     EXPECT_EQ(resimulate(f, f.a, commands, r.trajectory), "");
     if (is_bundle_planner(r.planner)) {
@@ -604,8 +604,7 @@ Trajectory expect_revalidated(const Fixture& f, const Simulator& sim, const Plan
   EXPECT_EQ(validate(f, t, p.start, p.goal.q, kTolerance, "lazysp"), "");
   std::vector<CommandProfile> commands;
   for (const PathStep& s : r.best_path) {
-    commands.push_back({s.knots.data(), static_cast<int>(s.knots.size() / f.robot.dof), f.robot.dof,
-                        s.command_duration});
+    commands.push_back(s.profile(f.robot.dof));
   }
   EXPECT_EQ(resimulate(f, p.start, commands, t), "");
   EXPECT_NEAR(r.best_cost, t.cost, 1e-9 * (1 + t.cost));
@@ -948,6 +947,49 @@ TEST(LazySp, AGoalInAPocketIsApproachedAlongAnEdgeLookedAtBackward) {
   std::cout << "[ lazysp  ] pocket: " << r.counters.simulations << " simulations with approaches, "
             << without.counters.simulations << " without ("
             << (without.success ? "solved" : "not solved") << ")\n";
+}
+
+// The shortcut of a candidate that looks free (parameter `shortcut`): a ball on the joint-space
+// line a -> c blocks the straight way, so the shortcut goes through a predicted state of the
+// candidate. Its straight parts are simulated as one command with the junction blended
+// (found_by "shortcut", one step with knot times), which the post-processing keeps without a
+// simulation; without the shortcut, the candidate's edges are simulated, each with its settle.
+TEST(LazySp, ACandidateThatLooksFreeIsSimulatedAsItsShortcut) {
+  const Fixture& f = fixture();
+  PlanningProblem p = library_problem(f.a, f.c, 10);
+  p.termination.stop_at_first = true;
+  const std::unique_ptr<BlockedScene> scene = scene_with_ball(f, 0.5 * (f.a + f.c), 0.04);
+  const Simulator& blocked = scene->sim;
+  SimulatorWorkspace ws(blocked);
+  ASSERT_EQ(check_state(blocked, ws, p.start), RolloutStatus::Valid);
+  ASSERT_EQ(check_state(blocked, ws, p.goal.q), RolloutStatus::Valid);
+  ASSERT_FALSE(line_looks_free(blocked, ws, p.start, p.goal.q)) << "the ball misses the line";
+  const PlanningContext context = session_context(f, blocked);
+  const PlanResult r = plan(context, ws, "lazysp", searching("lazysp", {{"shortcut", 1}}), p);
+  ASSERT_TRUE(r.success) << r.failure;
+  EXPECT_EQ(r.found_by, "shortcut");
+  ASSERT_EQ(r.best_path.size(), 1u);
+  const PathStep& step = r.best_path[0];
+  EXPECT_EQ(step.bundle_edge, -1);
+  EXPECT_FALSE(step.knot_times.empty()) << "not the blended command";
+  EXPECT_FALSE(step.outcome_rows.empty());
+  expect_revalidated(f, blocked, p, r);
+  ExecutionOptions options;
+  options.limits = context.command;
+  const ExecutableTrajectory e =
+      make_executable(blocked, ws, p.start, r.best_path, p.goal, options, kSampleEvery);
+  EXPECT_EQ(e.stats.simulations, 0);
+  EXPECT_EQ(e.stats.stops, 0);
+
+  const PlanResult edges = plan(context, ws, "lazysp", searching("lazysp"), p);
+  ASSERT_TRUE(edges.success) << edges.failure;
+  EXPECT_NE(edges.found_by, "shortcut");
+  double edge_seconds = 0;
+  for (const PathStep& s : edges.best_path) edge_seconds += s.outcome->duration;
+  EXPECT_LT(step.outcome->duration, edge_seconds);
+  std::cout << "[ lazysp  ] shortcut: one command of " << step.outcome->duration << " s in "
+            << r.counters.simulations << " simulations; the candidate's " << edges.best_path.size()
+            << " edges take " << edge_seconds << " s in " << edges.counters.simulations << "\n";
 }
 
 // The goal test's look: the lazy search's candidate for a joint goal ends where the straight line

@@ -102,9 +102,9 @@ TEST(Registry, NamesAndLookups) {
             (std::set<std::string>{"theta", "lazy_model", "goal_bias", "selection_radius",
                                    "pruning_ratio", "epsilon", "resolution", "risk_weight",
                                    "edge_penalty", "expansion_limit", "mark_weight", "direct",
-                                   "connect_radius", "candidate_radius", "precheck",
-                                   "approaches", "goal_look"}));
-  EXPECT_EQ(all.size(), 17u);  // each once
+                                   "connect_radius", "candidate_radius", "precheck", "approaches",
+                                   "goal_look", "shortcut"}));
+  EXPECT_EQ(all.size(), 18u);  // each once
 }
 
 // The refusals only: a planner registered here would stay for the other tests of a process that

@@ -12,8 +12,6 @@ namespace {
 // Peak |s'| and |s''| of the minimum-jerk blend on [0, 1] (command_profile.cpp).
 constexpr double kPeakSlope = 1.875;
 constexpr double kPeakCurvature = 5.773502691896258;
-// Fraction of the command limits a direct command between two steps uses.
-constexpr double kJunctionRoom = 0.7;
 
 // A rollout of this stage, kept with checkpoints at its knots, so that a later command from
 // the same start that agrees with it up to some knot goes on from there rather than being
@@ -72,9 +70,7 @@ bool within_limits(const RobotModel& robot, const CommandSampling& limits, int j
 
 RolloutResult simulate_step(Work& w, const JointVectorRef& from, const PathStep& s) {
   const int n = w.sim.robot.dof;
-  const CommandProfile p{s.knots.data(), static_cast<int>(s.knots.size() / n), n,
-                         s.command_duration};
-  const RolloutResult r = simulate(w.sim, w.ws, from, p);
+  const RolloutResult r = simulate(w.sim, w.ws, from, s.profile(n));
   w.stats.count(r);
   return r;
 }
@@ -108,11 +104,12 @@ std::vector<Step> raw_steps(const std::vector<PathStep>& steps, const RawChain& 
   for (size_t k = 0; k < steps.size(); ++k) {
     const int knots = static_cast<int>(steps[k].knots.size() / n);
     out[k].knots = steps[k].knots;
-    for (int j = 0; j < knots; ++j)
+    out[k].uniform = steps[k].knot_times.empty();
+    out[k].times = steps[k].knot_times;
+    for (int j = 0; out[k].uniform && j < knots; ++j)
       out[k].times.push_back(steps[k].command_duration * j / (knots - 1));
     out[k].target = raw.states[k + 1];
     out[k].first_raw = out[k].last_raw = static_cast<int>(k);
-    out[k].uniform = true;
     // The last step alone, from the raw chain's state, is simulated with the planners' settle
     // (final_sim): the planner's own simulation of it is that segment's, when it kept the rows.
     if (k + 1 == steps.size() && steps[k].outcome && !steps[k].outcome_rows.empty()) {
@@ -708,6 +705,50 @@ std::optional<PathStep> direct_step_to(const Simulator& sim, SimulatorWorkspace&
         land_in->contains(sim.robot, ws.robot, step.outcome->qf))
       return step;
     correct_command(times, step.knots, 1, last, target - step.outcome->qf);
+  }
+}
+
+std::optional<PathStep> blended_step_through(const Simulator& sim, SimulatorWorkspace& ws,
+                                             const ExecutionOptions& options,
+                                             const std::vector<JointVector>& points,
+                                             const Goal& land_in, int* simulations) {
+  const int n = sim.robot.dof;
+  const int parts = static_cast<int>(points.size()) - 1;
+  if (parts < 1) return std::nullopt;
+  CommandSampling limits = options.limits;
+  if (parts > 1) limits.limit_scale *= kJunctionRoom;
+  std::vector<Step> steps(parts);
+  for (int k = 0; k < parts; ++k) {
+    if (!direct_command(sim.robot, limits, points[k + 1] - points[k], sim.dt, steps[k].times,
+                        steps[k].knots))
+      return std::nullopt;
+  }
+  std::vector<double> scale;
+  for (int k = 0; k + 1 < parts; ++k) {
+    const Step& st = steps[k];
+    const Step& next = steps[k + 1];
+    const int count = static_cast<int>(st.times.size());
+    scale.push_back(blend_scale(sim.robot, options, &st.knots[(count - 2) * n], &next.knots[n],
+                                st.times[count - 1] - st.times[count - 2],
+                                next.times[1] - next.times[0]));
+    if (scale.back() == 0) return std::nullopt;
+  }
+  Joined j = join_steps(steps, 0, parts - 1, scale, n);
+  PathStep step;
+  step.knots = std::move(j.knots);
+  step.knot_times = std::move(j.times);
+  step.command_duration = step.knot_times.back();
+  const int last = static_cast<int>(step.knot_times.size()) - 1;
+  for (int round = 0;; ++round) {
+    step.outcome_rows.clear();
+    step.outcome = simulate(sim, ws, points.front(), step.profile(n),
+                            {nullptr, nullptr, 0, &step.outcome_rows});
+    if (simulations) *simulations = round + 1;
+    if (round >= kDirectCorrections || !step.outcome->valid() ||
+        land_in.contains(sim.robot, ws.robot, step.outcome->qf))
+      return step;
+    correct_command(step.knot_times, step.knots, j.last_step_first_knot, last,
+                    points.back() - step.outcome->qf);
   }
 }
 

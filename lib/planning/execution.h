@@ -154,6 +154,10 @@ Trajectory returned_trajectory(const Simulator& sim, SimulatorWorkspace& ws,
                                bool raw, const ExecutionOptions& options, int sample_every,
                                ExecutionStats& stats);
 
+// Fraction of the command limits (limit_scale) a direct command with a junction at either end
+// uses, so that a blend of the junction fits within them (at the limits none would).
+constexpr double kJunctionRoom = 0.7;
+
 // A joint-space straight line from rest by `displacement` to rest, as fast as `limits` allow the
 // commanded velocity, acceleration and jerk (N intervals: knots 0, v, ..., v, 0); false when
 // the displacement is (numerically) zero.
@@ -174,6 +178,19 @@ std::optional<PathStep> direct_step_to(const Simulator& sim, SimulatorWorkspace&
                                        const CommandSampling& limits, const JointVectorRef& from,
                                        const JointVector& target, const Goal* land_in,
                                        int* simulations = nullptr);
+// Straight commands from `points[0]` through each later point, the junctions between them
+// blended (ExecutionOptions::blend_scales, the first within options.limits; each command within
+// kJunctionRoom of them), joined into one command with knot times (PathStep::knot_times), as
+// the post-processing would join them, simulated with every check from points[0] and, while it
+// lands outside `land_in`, corrected by the miss in its last command's knots (up to
+// kDirectCorrections times): one rollout where the chain of rest-to-rest commands and then
+// its blend would be two. The step with its last simulation and rows (valid or not); none when
+// a junction cannot be blended within the limits or two points coincide. `simulations` (when
+// given) gets how many it ran.
+std::optional<PathStep> blended_step_through(const Simulator& sim, SimulatorWorkspace& ws,
+                                             const ExecutionOptions& options,
+                                             const std::vector<JointVector>& points,
+                                             const Goal& land_in, int* simulations = nullptr);
 // What direct_step aims at: the joint goal, or a pose goal's configuration `target`; null when
 // it has no such configuration.
 const JointVector* direct_target(const Goal& goal, int target);

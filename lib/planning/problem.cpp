@@ -214,8 +214,7 @@ Trajectory realize_path(const Simulator& sim, SimulatorWorkspace& ws, const Join
   std::vector<float> sq, sdq;
   for (size_t k = 0; k < steps.size(); ++k) {
     const PathStep& s = steps[k];
-    const CommandProfile profile{s.knots.data(), static_cast<int>(s.knots.size() / n), n,
-                                 s.command_duration};
+    const CommandProfile profile = s.profile(n);
     sq.clear();
     sdq.clear();
     const RolloutResult r = simulate(sim, ws, q, profile, {&sq, &sdq, sample_every});

@@ -120,6 +120,13 @@ struct PathStep {
   int64_t bundle_edge = -1;  // the bundle edge whose command this is, or -1 (RRT/SST, direct)
   std::vector<double> knots;
   double command_duration = 0;
+  // The knots' times, s, from 0 to command_duration (a blended command's); empty: evenly
+  // spaced, as a bundle edge's and a sampled command's are.
+  std::vector<double> knot_times;
+  CommandProfile profile(int dof) const {
+    return {knots.data(), static_cast<int>(knots.size() / dof), dof, command_duration,
+            knot_times.empty() ? nullptr : knot_times.data()};
+  }
   // The planner's own valid simulation of this command from the previous step's end state (the
   // exact start for the first step) with the context's simulator, when it hands it over: the
   // post-processing takes it as the raw chain's instead of simulating the step again (issue
@@ -145,9 +152,10 @@ struct PlanResult {
   PlannerCounters counters;
   std::string failure;  // why there is no solution
   // Which part of the planner found the best path, for planners with several: "direct" (the
-  // bundle planners' straight command, tried first), "bundle", "growth", "connection" or
-  // "approach" (lazysp's search, growth, direct command into the goal from a near state, or the
-  // way in through an approach where that collided); "start" for
+  // bundle planners' straight command, tried first), "bundle", "growth", "connection",
+  // "approach" or "shortcut" (lazysp's search, growth, direct command into the goal from a near
+  // state, the way in through an approach where that collided, or a candidate's shortcut);
+  // "start" for
   // any planner when the start already lay in the goal region (the path of no motion); else
   // empty.
   std::string found_by;

@@ -200,12 +200,31 @@ class SearchState {
                                      int& simulations) {
     return connection(q, target, problem_.goal, simulations);
   }
-  // The same, corrected to land in `land_in`.
+  // The same, corrected to land in `land_in`; with `room` below 1, within that fraction of
+  // the command limits (kJunctionRoom: a blend of its junctions fits).
   std::optional<PathStep> connection(const JointVector& q, const JointVector& target,
-                                     const Goal& land_in, int& simulations) {
+                                     const Goal& land_in, int& simulations, double room = 1) {
     simulations = 0;
+    CommandSampling limits = ctx_.command;
+    limits.limit_scale *= room;
     std::optional<PathStep> step =
-        direct_step_to(ctx_.sim, ws_, ctx_.command, q, target, &land_in, &simulations);
+        direct_step_to(ctx_.sim, ws_, limits, q, target, &land_in, &simulations);
+    if (!step) return std::nullopt;
+    count_simulations(simulations, *step->outcome);
+    if (!step->outcome->valid()) return std::nullopt;
+    return step;
+  }
+
+  // Straight commands through `points` (from the first, a real state) blended into one
+  // (blended_step_through), corrected to land in the goal; the step when it simulates valid;
+  // `simulations` gets how many it ran (all counted here).
+  std::optional<PathStep> blended_connection(const std::vector<JointVector>& points,
+                                             int& simulations) {
+    simulations = 0;
+    ExecutionOptions options;
+    options.limits = ctx_.command;
+    std::optional<PathStep> step =
+        blended_step_through(ctx_.sim, ws_, options, points, problem_.goal, &simulations);
     if (!step) return std::nullopt;
     count_simulations(simulations, *step->outcome);
     if (!step->outcome->valid()) return std::nullopt;

@@ -87,7 +87,7 @@ struct Settings {
   double theta, epsilon, resolution, risk_weight, edge_penalty, goal_bias, mark_weight,
       connect_radius, candidate_radius;
   size_t expansion_limit;
-  bool direct, precheck, approaches, goal_look;
+  bool direct, precheck, approaches, goal_look, shortcut;
 };
 
 // A state of the lazy search: predicted (never simulated) or, for a source, a real node's.
@@ -107,6 +107,9 @@ using Neighbours = std::vector<std::pair<uint32_t, double>>;
 struct LazySpNode : SearchNode {
   int64_t bundle_edge = -1;  // the bundle edge from the parent, or -1
   int command = -1;          // else the growth's command (index into commands_), or -1: the root
+  // The direct command from here into a joint goal was tried (or its line looked blocked): the
+  // shortcut does not try it again.
+  bool goal_tried = false;
 };
 
 class LazySpSearch {
@@ -143,6 +146,11 @@ class LazySpSearch {
   bool improves(uint64_t cell, double g);
   void enqueue(Predicted x, double h);
   bool validate(const std::vector<Predicted>& chain);
+  bool shortcut(const std::vector<Predicted>& chain);
+  bool plan_shortcut(const std::vector<Predicted>& chain);
+  static constexpr int kReachedGoal = -2;
+  int shortcut_part(const std::vector<Predicted>& chain, int r, std::pair<int, bool> part);
+  bool blended_shortcut(const std::vector<Predicted>& chain, int r, size_t k);
   bool may_end_candidate(int p, double h);
   bool looks_free(const std::vector<Predicted>& chain);
   bool shifted_samples_free(const JointVector& from, uint32_t e);
@@ -221,7 +229,8 @@ class LazySpSearch {
             v.get("direct") != 0,
             v.get("precheck") != 0,
             v.get("approaches") != 0,
-            v.get("goal_look") != 0};
+            v.get("goal_look") != 0,
+            v.get("shortcut") != 0};
   }
 
   const PlanningContext& ctx_;
@@ -265,6 +274,9 @@ class LazySpSearch {
   // of it, through reached_by_growth)
   std::vector<std::pair<double, uint32_t>> ranked_;
   std::vector<PathStep> commands_;  // the growth's commands, by LazySpNode::command
+  // shortcut's parts: the waypoint each reaches (the candidate's index; its size: the goal) and
+  // whether by a straight command (else the candidate's edge)
+  std::vector<std::pair<int, bool>> shortcut_plan_;
   Neighbours neighbours_;
   JointVector from_, step_, next_;  // expand's scratch
   // One round of the lazy search (rebuilt every round from the real nodes).
@@ -289,6 +301,7 @@ PlanResult LazySpSearch::run() {
   RolloutResult at_start;
   at_start.qf = s_.problem().start;
   add_real(at_start, -1, -1, -1);
+  if (set_.direct) s_.node(0).goal_tried = true;
   // A predicted state x + qf(e) - q0(e), with x within the neighbourhood (theta) of q0(e), lies
   // as near qf(e): a joint goal farther than that + the lazy goal radius from every edge end is
   // beyond the lazy search, and only the growth can reach it.
@@ -337,7 +350,7 @@ void LazySpSearch::lazy_round() {
   if (!found) found = candidate(expansions, set_.expansion_limit, false, chain);
   // A candidate the look rejects costs no simulation; it counts a fraction of a failed one.
   const bool looked = found && (!looks_ || looks_free(chain));
-  if (looked && !validate(chain)) ++failed_candidates_;
+  if (looked && !shortcut(chain) && !validate(chain)) ++failed_candidates_;
   if (found && !looked) failed_candidates_ += kRejectedCandidate;
   lazy_work_ += static_cast<double>(successors_ - generated) / kSuccessorsPerRollout +
                 static_cast<double>(prechecks_ - checked) / kChecksPerRollout +
@@ -495,6 +508,102 @@ bool LazySpSearch::validate(const std::vector<Predicted>& chain) {
   return false;
 }
 
+// The candidate's shortcut, tried before its edges are simulated (parameter `shortcut`): for a
+// joint goal, the candidate's predicted states and then the goal are waypoints; from each, the
+// farthest later one whose joint-space line looks free (line_free) is reached by the straight
+// command to it, and where not even the next one's line looks free, the next waypoint by the
+// candidate's own edge (which the look passed). The post-processing would shortcut the
+// candidate so anyway, after simulating all of its edges and their settles. Each part is
+// simulated with every check, from the real end of the one before, the last run of straight
+// parts into the goal as one blended command (blended_shortcut). Where a part fails, the
+// candidate's edges are validated as before (validate), and the valid parts stay real nodes.
+// True when it reached the goal (found_by "shortcut").
+bool LazySpSearch::shortcut(const std::vector<Predicted>& chain) {
+  if (!set_.shortcut || s_.problem().goal.kind != Goal::Kind::Joint || !plan_shortcut(chain))
+    return false;
+  // The last run of straight parts, blended when it has more than one.
+  size_t blended_from = shortcut_plan_.size();
+  while (blended_from > 0 && shortcut_plan_[blended_from - 1].second) --blended_from;
+  if (shortcut_plan_.size() - blended_from < 2) blended_from = shortcut_plan_.size();
+  int r = chain.front().real;
+  for (size_t k = 0; k < shortcut_plan_.size(); ++k) {
+    if (s_.out_of_time()) return false;
+    // A blend that failed: so did its parts from rest to rest, nearly always (2 of 29 passed
+    // on three tuning sets), so they are not tried.
+    if (k == blended_from) return blended_shortcut(chain, r, k);
+    r = shortcut_part(chain, r, shortcut_plan_[k]);
+    if (r < 0) return r == kReachedGoal;
+  }
+  return false;
+}
+
+// One part of the shortcut from real node r: the real node it reaches, kReachedGoal, or -1
+// when it failed.
+int LazySpSearch::shortcut_part(const std::vector<Predicted>& chain, int r,
+                                std::pair<int, bool> part) {
+  const auto [to, straight] = part;
+  const int last = static_cast<int>(chain.size());  // the goal's waypoint
+  if (!straight) {
+    const uint32_t e = chain[to].edge;
+    tried_.insert(key(r, e));
+    const RolloutResult res = s_.simulate_from(s_.node(r).q, bundle_.command(e));
+    return res.valid() ? add_real(res, r, e, -1) : -1;
+  }
+  Goal landing;  // an intermediate waypoint is a place to pass, not to reach exactly
+  landing.q = to == last ? s_.problem().goal.q : chain[to].q;
+  landing.tolerance = kApproachLanding;
+  // Within kJunctionRoom of the limits, as the post-processing's shortcuts, when it has a
+  // junction to blend.
+  const double room = shortcut_plan_.size() > 1 ? kJunctionRoom : 1.0;
+  int simulations = 0;
+  std::optional<PathStep> step = s_.connection(
+      s_.node(r).q, landing.q, to == last ? s_.problem().goal : landing, simulations, room);
+  if (!step) return -1;
+  if (reached_by_connection(r, std::move(*step), "shortcut")) return kReachedGoal;
+  return to == last ? -1 : static_cast<int>(s_.nodes().size()) - 1;  // the landing
+}
+
+// The straight parts [k, end) of the shortcut, into the goal, from real node r, simulated as one
+// command with their junctions blended (blended_step_through), as the post-processing would
+// blend them: one rollout, where the parts and then their blend would be two, and the
+// post-processing keeps it as it is. True when it reached the goal; otherwise (a junction that
+// cannot be blended within the limits, a failed check, a landing outside the goal) false.
+bool LazySpSearch::blended_shortcut(const std::vector<Predicted>& chain, int r, size_t k) {
+  const int last = static_cast<int>(chain.size());
+  std::vector<JointVector> points = {s_.node(r).q};
+  for (; k < shortcut_plan_.size(); ++k) {
+    const int to = shortcut_plan_[k].first;
+    points.push_back(to == last ? s_.problem().goal.q : chain[to].q);
+  }
+  int simulations = 0;
+  std::optional<PathStep> step = s_.blended_connection(points, simulations);
+  return step && reached_by_connection(r, std::move(*step), "shortcut");
+}
+
+// shortcut's parts, into shortcut_plan_: false when they would be the candidate's edges alone
+// (nothing to gain), the last one, into the goal, does not look free, or the only one is the
+// direct command from the source into the goal, tried before (connect_to_goal, or the direct
+// command from the start).
+bool LazySpSearch::plan_shortcut(const std::vector<Predicted>& chain) {
+  const int last = static_cast<int>(chain.size());
+  const auto waypoint = [&](int i) -> const JointVector& {
+    return i == last ? s_.problem().goal.q : chain[i].q;
+  };
+  shortcut_plan_.clear();
+  bool straight_any = false;
+  for (int i = 0; i < last;) {
+    int j = last;
+    while (j > i + 1 && !s_.line_free(waypoint(i), waypoint(j), &prechecks_)) --j;
+    const bool straight = j > i + 1 || s_.line_free(waypoint(i), waypoint(j), &prechecks_);
+    if (!straight && j == last) return false;
+    shortcut_plan_.emplace_back(j, straight);
+    straight_any = straight_any || (straight && j < last);
+    i = j;
+  }
+  if (shortcut_plan_.size() == 1 && s_.node(chain.front().real).goal_tried) return false;
+  return straight_any || shortcut_plan_.size() < chain.size();
+}
+
 // The look before the simulations: each edge of the candidate with its stored samples shifted to
 // the edge's predicted start (the displacement transfer applied to the whole motion), checked as
 // the simulator checks a state. A collision there leaves that edge out from that start's cell for
@@ -609,6 +718,7 @@ bool LazySpSearch::connect_to_goal(int v) {
   if (goal.kind != Goal::Kind::Joint) {
     step = s_.goal_connection(node.q, simulations);
   } else if (set_.connect_radius > 0 && node.h <= set_.connect_radius) {
+    s_.node(v).goal_tried = true;
     line_blocked = set_.precheck && !s_.line_free(node.q, goal.q, &prechecks_);
     if (!line_blocked) step = s_.connection(node.q, goal.q, simulations);
   }
@@ -621,13 +731,16 @@ bool LazySpSearch::connect_to_goal(int v) {
 }
 
 // The real node of a connection's step from v; true (a solution) when it lies in the goal.
+// A solution's step keeps its per-tick rows (the post-processing takes them as the last step's
+// simulation); other steps drop them.
 bool LazySpSearch::reached_by_connection(int v, PathStep step, const char* by) {
-  const RolloutResult outcome = *step.outcome;
-  commands_.push_back({-1, std::move(step.knots), step.command_duration});
-  const int c = add_real(outcome, v, -1, static_cast<int>(commands_.size()) - 1);
-  if (!s_.in_goal(s_.node(c).h)) return false;
-  found(c, by);
-  return true;
+  const int c = add_real(*step.outcome, v, -1, static_cast<int>(commands_.size()));
+  const bool solution = s_.in_goal(s_.node(c).h);
+  if (!solution) std::vector<double>().swap(step.outcome_rows);
+  step.outcome.reset();  // the node's (path_to)
+  commands_.push_back(std::move(step));
+  if (solution) found(c, by);
+  return solution;
 }
 
 // The look backward from a joint goal in a pocket, where the straight way in keeps colliding:
@@ -821,6 +934,12 @@ PlannerInfo lazysp_planner_info() {
                         "where direct commands into a joint goal keep colliding, look backward "
                         "from it (bundle edges shifted to end there) and come in along one "
                         "that looks free (found_by \"approach\"; needs precheck)"),
+      boolean_parameter("shortcut", true,
+                        "for a joint goal, simulate a candidate that looks free first as its "
+                        "shortcut: straight commands between its predicted states and the goal "
+                        "where their joint-space lines look free, its own edges elsewhere "
+                        "(found_by \"shortcut\"); when a part fails, its edges as before (needs "
+                        "precheck)"),
       boolean_parameter("goal_look", true,
                         "a candidate ending near a joint goal ends where the joint-space line "
                         "into the goal looks free, passing over up to 256 ends per round whose "
