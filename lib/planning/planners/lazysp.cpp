@@ -519,7 +519,8 @@ bool LazySpSearch::validate(const std::vector<Predicted>& chain) {
 // candidate's edges are validated as before (validate), and the valid parts stay real nodes.
 // True when it reached the goal (found_by "shortcut").
 bool LazySpSearch::shortcut(const std::vector<Predicted>& chain) {
-  if (!set_.shortcut || s_.problem().goal.kind != Goal::Kind::Joint || !plan_shortcut(chain))
+  if (!set_.shortcut || !looks_ || s_.problem().goal.kind != Goal::Kind::Joint ||
+      !plan_shortcut(chain))
     return false;
   // The last run of straight parts, blended when it has more than one.
   size_t blended_from = shortcut_plan_.size();
@@ -939,7 +940,7 @@ PlannerInfo lazysp_planner_info() {
                         "shortcut: straight commands between its predicted states and the goal "
                         "where their joint-space lines look free, its own edges elsewhere "
                         "(found_by \"shortcut\"); when a part fails, its edges as before (needs "
-                        "precheck)"),
+                        "precheck and a bundle with stored samples)"),
       boolean_parameter("goal_look", true,
                         "a candidate ending near a joint goal ends where the joint-space line "
                         "into the goal looks free, passing over up to 256 ends per round whose "
