@@ -171,7 +171,8 @@ ParameterValues searching(const std::string& planner, ParameterValues values) {
   if (info && info->parameter("direct")) values.set("direct", 0);
   if (info && info->parameter("connect_radius") && !values.has("connect_radius"))
     values.set("connect_radius", 0);
-  if (info && info->parameter("shortcut") && !values.has("shortcut")) values.set("shortcut", 0);
+  if (info && info->parameter("candidate_shortcut") && !values.has("candidate_shortcut"))
+    values.set("candidate_shortcut", 0);
   return values;
 }
 

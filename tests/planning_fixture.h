@@ -96,7 +96,7 @@ inline const std::vector<std::string> kPlanners = own_planners();
 bool is_bundle_planner(const std::string& planner);
 // `values` with direct = false for a planner that declares `direct`: tests of a search run the
 // search, not the straight command tried before it (tested on its own in test_execution); and
-// for lazysp connect_radius = 0 and shortcut = 0 unless given (its paths then are of bundle
+// for lazysp connect_radius = 0 and candidate_shortcut = 0 unless given (its paths then are of bundle
 // edges and growth commands only; the connection and the shortcut are tested on their own in
 // test_planners).
 ParameterValues searching(const std::string& planner, ParameterValues values = {});

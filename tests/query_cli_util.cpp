@@ -56,7 +56,7 @@ json query(const std::string& id, const JointVectorRef& start, const JointVector
   const ParameterValues only_search = searching(planner);
   if (only_search.has("direct")) q["direct"] = false;
   if (only_search.has("connect_radius")) q["connect_radius"] = 0;
-  if (only_search.has("shortcut")) q["shortcut"] = false;
+  if (only_search.has("candidate_shortcut")) q["candidate_shortcut"] = false;
   return q;
 }
 

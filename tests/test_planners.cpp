@@ -965,7 +965,8 @@ TEST(LazySp, ACandidateThatLooksFreeIsSimulatedAsItsShortcut) {
   ASSERT_EQ(check_state(blocked, ws, p.goal.q), RolloutStatus::Valid);
   ASSERT_FALSE(line_looks_free(blocked, ws, p.start, p.goal.q)) << "the ball misses the line";
   const PlanningContext context = session_context(f, blocked);
-  const PlanResult r = plan(context, ws, "lazysp", searching("lazysp", {{"shortcut", 1}}), p);
+  const PlanResult r =
+      plan(context, ws, "lazysp", searching("lazysp", {{"candidate_shortcut", 1}}), p);
   ASSERT_TRUE(r.success) << r.failure;
   EXPECT_EQ(r.found_by, "shortcut");
   ASSERT_EQ(r.best_path.size(), 1u);

@@ -103,7 +103,7 @@ TEST(Registry, NamesAndLookups) {
                                    "pruning_ratio", "epsilon", "resolution", "risk_weight",
                                    "edge_penalty", "expansion_limit", "mark_weight", "direct",
                                    "connect_radius", "candidate_radius", "precheck", "approaches",
-                                   "goal_look", "shortcut"}));
+                                   "goal_look", "candidate_shortcut"}));
   EXPECT_EQ(all.size(), 18u);  // each once
 }
 

@@ -134,9 +134,7 @@ const Samples& real_edge() {
     const PlannedPath& p = planned_paths()[0];
     const PathStep& step = p.steps[0];
     const int n = fixture().robot.dof;
-    return simulate_at_control_rate(
-        p.start, CommandProfile{step.knots.data(), static_cast<int>(step.knots.size() / n), n,
-                                step.command_duration});
+    return simulate_at_control_rate(p.start, step.profile(n));
   }();
   return s;
 }
@@ -152,8 +150,7 @@ TEST(TrajectoryCheck, EveryEdgeOfPlannedPathsPassesAtTheControlRate) {
   for (const PlannedPath& p : planned_paths()) {
     JointVector q = p.start;
     for (const PathStep& step : p.steps) {
-      const CommandProfile profile{step.knots.data(), static_cast<int>(step.knots.size() / n), n,
-                                   step.command_duration};
+      const CommandProfile profile = step.profile(n);
       const Samples s = simulate_at_control_rate(q, profile);
       const TrajectoryCheckResult r = check(s);
       EXPECT_TRUE(r.valid) << "edge " << step.bundle_edge << ": " << text(r);
@@ -197,8 +194,7 @@ TEST(TrajectoryCheck, RawChainsFailOnlyAtTheirJunctions) {
     JointVector q = p.start;
     for (size_t k = 0; k + 1 < p.steps.size(); ++k) {
       const PathStep& step = p.steps[k];
-      const CommandProfile profile{step.knots.data(), static_cast<int>(step.knots.size() / 7), 7,
-                                   step.command_duration};
+      const CommandProfile profile = step.profile(7);
       const RolloutResult rr = simulate(f.sim, ws, q, profile);
       q = rr.qf;
       t_end += rr.duration;

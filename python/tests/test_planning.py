@@ -357,7 +357,7 @@ def test_a_free_straight_command_is_the_answer(session):
         assert r.to_dict()["post_processing"]["simulations"] == 0  # nothing simulated twice
         searching = {"planner": planner, "seed": 1, "direct": False}
         if planner == "lazysp":
-            searching["shortcut"] = False  # its candidate's shortcut would be that command
+            searching["candidate_shortcut"] = False  # its candidate's shortcut would be that command
         searched = session.plan(**query(searching))
         assert searched.success and searched.found_by != "direct", planner
         assert searched.counters["simulations"] > 1

@@ -87,7 +87,7 @@ struct Settings {
   double theta, epsilon, resolution, risk_weight, edge_penalty, goal_bias, mark_weight,
       connect_radius, candidate_radius;
   size_t expansion_limit;
-  bool direct, precheck, approaches, goal_look, shortcut;
+  bool direct, precheck, approaches, goal_look, candidate_shortcut;
 };
 
 // A state of the lazy search: predicted (never simulated) or, for a source, a real node's.
@@ -145,11 +145,17 @@ class LazySpSearch {
   // Whether g is the cheapest so far in `cell` (then recorded as such).
   bool improves(uint64_t cell, double g);
   void enqueue(Predicted x, double h);
-  bool validate(const std::vector<Predicted>& chain);
-  bool shortcut(const std::vector<Predicted>& chain);
+  bool validate(const std::vector<Predicted>& chain, size_t from, int r);
+  bool shortcut(const std::vector<Predicted>& chain, size_t& from, int& r);
   bool plan_shortcut(const std::vector<Predicted>& chain);
+  // A part of the shortcut: the waypoint it reaches (an index of the candidate; its size: the
+  // goal), by a straight command or else by the candidate's edge.
+  struct ShortcutPart {
+    int to;
+    bool straight;
+  };
   static constexpr int kReachedGoal = -2;
-  int shortcut_part(const std::vector<Predicted>& chain, int r, std::pair<int, bool> part);
+  int shortcut_part(const std::vector<Predicted>& chain, int r, ShortcutPart part);
   bool blended_shortcut(const std::vector<Predicted>& chain, int r, size_t k);
   bool may_end_candidate(int p, double h);
   bool looks_free(const std::vector<Predicted>& chain);
@@ -230,7 +236,7 @@ class LazySpSearch {
             v.get("precheck") != 0,
             v.get("approaches") != 0,
             v.get("goal_look") != 0,
-            v.get("shortcut") != 0};
+            v.get("candidate_shortcut") != 0};
   }
 
   const PlanningContext& ctx_;
@@ -273,10 +279,8 @@ class LazySpSearch {
   // grow_along_bundle's scratch, and approach_from's (reached from grow_along_bundle's last use
   // of it, through reached_by_growth)
   std::vector<std::pair<double, uint32_t>> ranked_;
-  std::vector<PathStep> commands_;  // the growth's commands, by LazySpNode::command
-  // shortcut's parts: the waypoint each reaches (the candidate's index; its size: the goal) and
-  // whether by a straight command (else the candidate's edge)
-  std::vector<std::pair<int, bool>> shortcut_plan_;
+  std::vector<PathStep> commands_;           // the growth's commands, by LazySpNode::command
+  std::vector<ShortcutPart> shortcut_plan_;  // plan_shortcut's
   Neighbours neighbours_;
   JointVector from_, step_, next_;  // expand's scratch
   // One round of the lazy search (rebuilt every round from the real nodes).
@@ -350,7 +354,11 @@ void LazySpSearch::lazy_round() {
   if (!found) found = candidate(expansions, set_.expansion_limit, false, chain);
   // A candidate the look rejects costs no simulation; it counts a fraction of a failed one.
   const bool looked = found && (!looks_ || looks_free(chain));
-  if (looked && !shortcut(chain) && !validate(chain)) ++failed_candidates_;
+  if (looked) {
+    size_t from = 0;  // validate goes on after the edges the shortcut simulated first
+    int r = chain.front().real;
+    if (!shortcut(chain, from, r) && !validate(chain, from, r)) ++failed_candidates_;
+  }
   if (found && !looked) failed_candidates_ += kRejectedCandidate;
   lazy_work_ += static_cast<double>(successors_ - generated) / kSuccessorsPerRollout +
                 static_cast<double>(prechecks_ - checked) / kChecksPerRollout +
@@ -487,10 +495,10 @@ void LazySpSearch::enqueue(Predicted x, double h) {
 // A failed edge stays tried from that real state; the valid prefix stays in the tree as real
 // nodes, from which the next round plans. A real end farther than theta/2 from its prediction
 // ends the validation: the rest of the candidate was planned from a place the robot is not.
-// True when it reached the goal.
-bool LazySpSearch::validate(const std::vector<Predicted>& chain) {
-  int r = chain.front().real;
-  for (size_t k = 1; k < chain.size(); ++k) {
+// True when it reached the goal. It starts after the candidate's first `from` edges, at their
+// real end r (the shortcut's, which simulated them).
+bool LazySpSearch::validate(const std::vector<Predicted>& chain, size_t from, int r) {
+  for (size_t k = from + 1; k < chain.size(); ++k) {
     if (s_.out_of_time()) return false;
     const uint32_t e = chain[k].edge;
     tried_.insert(key(r, e));
@@ -508,72 +516,76 @@ bool LazySpSearch::validate(const std::vector<Predicted>& chain) {
   return false;
 }
 
-// The candidate's shortcut, tried before its edges are simulated (parameter `shortcut`): for a
-// joint goal, the candidate's predicted states and then the goal are waypoints; from each, the
-// farthest later one whose joint-space line looks free (line_free) is reached by the straight
-// command to it, and where not even the next one's line looks free, the next waypoint by the
-// candidate's own edge (which the look passed). The post-processing would shortcut the
-// candidate so anyway, after simulating all of its edges and their settles. Each part is
-// simulated with every check, from the real end of the one before, the last run of straight
-// parts into the goal as one blended command (blended_shortcut). Where a part fails, the
-// candidate's edges are validated as before (validate), and the valid parts stay real nodes.
-// True when it reached the goal (found_by "shortcut").
-bool LazySpSearch::shortcut(const std::vector<Predicted>& chain) {
-  if (!set_.shortcut || !looks_ || s_.problem().goal.kind != Goal::Kind::Joint ||
+// The candidate's shortcut (parameter `candidate_shortcut`; docs/algorithms.md), tried before
+// its edges are simulated one by one: the post-processing would make it of the candidate
+// anyway, after simulating every edge with its settle. Its parts run from the real end of the
+// one before; where one fails, validate goes on from the real end of the candidate's edges the
+// shortcut simulated first (`from`, `r`), and the other valid parts stay real nodes. True when
+// it reached the goal (found_by "shortcut").
+bool LazySpSearch::shortcut(const std::vector<Predicted>& chain, size_t& from, int& r) {
+  if (!set_.candidate_shortcut || !looks_ || s_.problem().goal.kind != Goal::Kind::Joint ||
       !plan_shortcut(chain))
     return false;
   // The last run of straight parts, blended when it has more than one.
   size_t blended_from = shortcut_plan_.size();
-  while (blended_from > 0 && shortcut_plan_[blended_from - 1].second) --blended_from;
+  while (blended_from > 0 && shortcut_plan_[blended_from - 1].straight) --blended_from;
   if (shortcut_plan_.size() - blended_from < 2) blended_from = shortcut_plan_.size();
-  int r = chain.front().real;
+  int at = r;
+  bool edges_only = true;  // so far: the candidate's own edges, which validate need not repeat
   for (size_t k = 0; k < shortcut_plan_.size(); ++k) {
     if (s_.out_of_time()) return false;
-    // A blend that failed: so did its parts from rest to rest, nearly always (2 of 29 passed
-    // on three tuning sets), so they are not tried.
-    if (k == blended_from) return blended_shortcut(chain, r, k);
-    r = shortcut_part(chain, r, shortcut_plan_[k]);
-    if (r < 0) return r == kReachedGoal;
+    // After a failed blend its parts from rest to rest passed 2 times in 29 (three tuning
+    // sets): the candidate's edges are tried instead.
+    if (k == blended_from) return blended_shortcut(chain, at, k);
+    at = shortcut_part(chain, at, shortcut_plan_[k]);
+    if (at < 0) return at == kReachedGoal;
+    edges_only = edges_only && !shortcut_plan_[k].straight;
+    if (edges_only) {
+      from = static_cast<size_t>(shortcut_plan_[k].to);
+      r = at;
+    }
   }
   return false;
 }
 
 // One part of the shortcut from real node r: the real node it reaches, kReachedGoal, or -1
 // when it failed.
-int LazySpSearch::shortcut_part(const std::vector<Predicted>& chain, int r,
-                                std::pair<int, bool> part) {
-  const auto [to, straight] = part;
+int LazySpSearch::shortcut_part(const std::vector<Predicted>& chain, int r, ShortcutPart part) {
   const int last = static_cast<int>(chain.size());  // the goal's waypoint
-  if (!straight) {
-    const uint32_t e = chain[to].edge;
+  if (!part.straight) {
+    const uint32_t e = chain[part.to].edge;
     tried_.insert(key(r, e));
     const RolloutResult res = s_.simulate_from(s_.node(r).q, bundle_.command(e));
-    return res.valid() ? add_real(res, r, e, -1) : -1;
+    if (!res.valid()) return -1;
+    const int c = add_real(res, r, e, -1);
+    if (!s_.in_goal(s_.node(c).h)) return c;
+    found(c, "shortcut");
+    return kReachedGoal;
   }
+  const bool into_goal = part.to == last;
+  if (into_goal) s_.node(r).goal_tried = true;  // that command is not tried again from r
   Goal landing;  // an intermediate waypoint is a place to pass, not to reach exactly
-  landing.q = to == last ? s_.problem().goal.q : chain[to].q;
+  landing.q = into_goal ? s_.problem().goal.q : chain[part.to].q;
   landing.tolerance = kApproachLanding;
-  // Within kJunctionRoom of the limits, as the post-processing's shortcuts, when it has a
-  // junction to blend.
+  // Within kJunctionRoom of the limits where the post-processing may blend a junction.
   const double room = shortcut_plan_.size() > 1 ? kJunctionRoom : 1.0;
   int simulations = 0;
   std::optional<PathStep> step = s_.connection(
-      s_.node(r).q, landing.q, to == last ? s_.problem().goal : landing, simulations, room);
+      s_.node(r).q, landing.q, into_goal ? s_.problem().goal : landing, simulations, room);
   if (!step) return -1;
   if (reached_by_connection(r, std::move(*step), "shortcut")) return kReachedGoal;
-  return to == last ? -1 : static_cast<int>(s_.nodes().size()) - 1;  // the landing
+  return into_goal ? -1 : static_cast<int>(s_.nodes().size()) - 1;  // the landing
 }
 
-// The straight parts [k, end) of the shortcut, into the goal, from real node r, simulated as one
-// command with their junctions blended (blended_step_through), as the post-processing would
-// blend them: one rollout, where the parts and then their blend would be two, and the
-// post-processing keeps it as it is. True when it reached the goal; otherwise (a junction that
-// cannot be blended within the limits, a failed check, a landing outside the goal) false.
+// The straight parts [k, end) of the shortcut, into the goal, from real node r as one command
+// with their junctions blended (blended_step_through): one rollout where the parts and then
+// the post-processing's blend of them would be two. False when a junction cannot be blended
+// within the limits, a check fails or it lands outside the goal.
 bool LazySpSearch::blended_shortcut(const std::vector<Predicted>& chain, int r, size_t k) {
   const int last = static_cast<int>(chain.size());
   std::vector<JointVector> points = {s_.node(r).q};
   for (; k < shortcut_plan_.size(); ++k) {
-    const int to = shortcut_plan_[k].first;
+    const int to = shortcut_plan_[k].to;
     points.push_back(to == last ? s_.problem().goal.q : chain[to].q);
   }
   int simulations = 0;
@@ -581,10 +593,11 @@ bool LazySpSearch::blended_shortcut(const std::vector<Predicted>& chain, int r, 
   return step && reached_by_connection(r, std::move(*step), "shortcut");
 }
 
-// shortcut's parts, into shortcut_plan_: false when they would be the candidate's edges alone
-// (nothing to gain), the last one, into the goal, does not look free, or the only one is the
-// direct command from the source into the goal, tried before (connect_to_goal, or the direct
-// command from the start).
+// The shortcut's parts (shortcut_plan_): waypoints are the candidate's states and then the goal;
+// from each, the farthest later one whose joint-space line looks free is reached by a straight
+// command, else the next one by the candidate's edge. False when that would be the candidate's
+// edges alone (nothing to gain), the last part, into the goal, does not look free, or the only
+// part is the direct command from the source into the goal, tried before.
 bool LazySpSearch::plan_shortcut(const std::vector<Predicted>& chain) {
   const int last = static_cast<int>(chain.size());
   const auto waypoint = [&](int i) -> const JointVector& {
@@ -597,7 +610,7 @@ bool LazySpSearch::plan_shortcut(const std::vector<Predicted>& chain) {
     while (j > i + 1 && !s_.line_free(waypoint(i), waypoint(j), &prechecks_)) --j;
     const bool straight = j > i + 1 || s_.line_free(waypoint(i), waypoint(j), &prechecks_);
     if (!straight && j == last) return false;
-    shortcut_plan_.emplace_back(j, straight);
+    shortcut_plan_.push_back({j, straight});
     straight_any = straight_any || (straight && j < last);
     i = j;
   }
@@ -732,15 +745,15 @@ bool LazySpSearch::connect_to_goal(int v) {
 }
 
 // The real node of a connection's step from v; true (a solution) when it lies in the goal.
-// A solution's step keeps its per-tick rows (the post-processing takes them as the last step's
-// simulation); other steps drop them.
+// The step's per-tick rows go into a solution's path (found copies it; the post-processing
+// takes them as the last step's simulation), and are not kept beyond that.
 bool LazySpSearch::reached_by_connection(int v, PathStep step, const char* by) {
   const int c = add_real(*step.outcome, v, -1, static_cast<int>(commands_.size()));
   const bool solution = s_.in_goal(s_.node(c).h);
-  if (!solution) std::vector<double>().swap(step.outcome_rows);
   step.outcome.reset();  // the node's (path_to)
   commands_.push_back(std::move(step));
   if (solution) found(c, by);
+  std::vector<double>().swap(commands_.back().outcome_rows);
   return solution;
 }
 
@@ -890,8 +903,8 @@ PlannerInfo lazysp_planner_info() {
   info.name = "lazysp";
   info.description =
       "lazy shortest path over predicted (transferred) edge ends; looks at a candidate's edges, "
-      "then simulates only the candidate path; grows along bundle edges that look free, else "
-      "by random commands; anytime";
+      "then simulates only the candidate path (first as its shortcut); grows along bundle edges "
+      "that look free, else by random commands; anytime";
   info.needs.bundle = true;
   ParameterSpec limit = real_parameter(
       "expansion_limit", 20000, 1, false,
@@ -935,7 +948,7 @@ PlannerInfo lazysp_planner_info() {
                         "where direct commands into a joint goal keep colliding, look backward "
                         "from it (bundle edges shifted to end there) and come in along one "
                         "that looks free (found_by \"approach\"; needs precheck)"),
-      boolean_parameter("shortcut", true,
+      boolean_parameter("candidate_shortcut", true,
                         "for a joint goal, simulate a candidate that looks free first as its "
                         "shortcut: straight commands between its predicted states and the goal "
                         "where their joint-space lines look free, its own edges elsewhere "
