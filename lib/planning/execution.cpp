@@ -501,18 +501,20 @@ Attempt try_segment(Work& w, const std::vector<Step>& steps, const RawChain& raw
 }
 
 // The blend scale of every junction after step a (0: cannot be blended within the limits).
+// The blend scale of the junction between `st` and `next` (0: none within the limits).
+double junction_scale(const RobotModel& robot, const ExecutionOptions& options, const Step& st,
+                      const Step& next) {
+  const int n = robot.dof;
+  const int count = static_cast<int>(st.times.size());
+  return blend_scale(robot, options, &st.knots[(count - 2) * n], &next.knots[n],
+                     st.times[count - 1] - st.times[count - 2], next.times[1] - next.times[0]);
+}
+
 std::vector<double> junction_scales(const Work& w, const std::vector<Step>& steps, int a) {
-  const int n = w.sim.robot.dof;
   std::vector<double> scale;
   for (int s = a; s + 1 < static_cast<int>(steps.size()); ++s) {
-    const Step& st = steps[s];
-    const Step& next = steps[s + 1];
-    const int count = static_cast<int>(st.times.size());
-    scale.push_back(w.options.blend
-                        ? blend_scale(w.sim.robot, w.options, &st.knots[(count - 2) * n],
-                                      &next.knots[n], st.times[count - 1] - st.times[count - 2],
-                                      next.times[1] - next.times[0])
-                        : 0.0);
+    scale.push_back(w.options.blend ? junction_scale(w.sim.robot, w.options, steps[s], steps[s + 1])
+                                    : 0.0);
   }
   return scale;
 }
@@ -684,6 +686,29 @@ ExecutableTrajectory make_executable(const Simulator& sim, SimulatorWorkspace& w
   return out;
 }
 
+namespace {
+
+// Simulates `step` from `from` with every check and its rows; while it ends valid outside
+// `land_in` (null: never), corrects knots [first, last) of its command (knot times `times`) by
+// the miss from `target` and simulates again, up to kDirectCorrections times.
+void land(const Simulator& sim, SimulatorWorkspace& ws, const JointVectorRef& from,
+          const JointVector& target, const Goal* land_in, std::vector<double>& times, int first,
+          PathStep& step, int* simulations) {
+  const int last = static_cast<int>(times.size()) - 1;
+  for (int round = 0;; ++round) {
+    step.outcome_rows.clear();
+    step.outcome = simulate(sim, ws, from, step.profile(sim.robot.dof),
+                            {nullptr, nullptr, 0, &step.outcome_rows});
+    if (simulations) *simulations = round + 1;
+    if (!land_in || round >= kDirectCorrections || !step.outcome->valid() ||
+        land_in->contains(sim.robot, ws.robot, step.outcome->qf))
+      return;
+    correct_command(times, step.knots, first, last, target - step.outcome->qf);
+  }
+}
+
+}  // namespace
+
 std::optional<PathStep> direct_step_to(const Simulator& sim, SimulatorWorkspace& ws,
                                        const CommandSampling& limits, const JointVectorRef& from,
                                        const JointVector& target, const Goal* land_in,
@@ -694,18 +719,8 @@ std::optional<PathStep> direct_step_to(const Simulator& sim, SimulatorWorkspace&
     return std::nullopt;
   // Evenly spaced knots (times[j] = j h), simulated as such: as a path step is.
   step.command_duration = times.back();
-  const int last = static_cast<int>(times.size()) - 1;
-  for (int round = 0;; ++round) {
-    const CommandProfile profile{step.knots.data(), static_cast<int>(times.size()), sim.robot.dof,
-                                 step.command_duration};
-    step.outcome_rows.clear();
-    step.outcome = simulate(sim, ws, from, profile, {nullptr, nullptr, 0, &step.outcome_rows});
-    if (simulations) *simulations = round + 1;
-    if (!land_in || round >= kDirectCorrections || !step.outcome->valid() ||
-        land_in->contains(sim.robot, ws.robot, step.outcome->qf))
-      return step;
-    correct_command(times, step.knots, 1, last, target - step.outcome->qf);
-  }
+  land(sim, ws, from, target, land_in, times, 1, step, simulations);
+  return step;
 }
 
 std::optional<PathStep> blended_step_through(const Simulator& sim, SimulatorWorkspace& ws,
@@ -725,12 +740,7 @@ std::optional<PathStep> blended_step_through(const Simulator& sim, SimulatorWork
   }
   std::vector<double> scale;
   for (int k = 0; k + 1 < parts; ++k) {
-    const Step& st = steps[k];
-    const Step& next = steps[k + 1];
-    const int count = static_cast<int>(st.times.size());
-    scale.push_back(blend_scale(sim.robot, options, &st.knots[(count - 2) * n], &next.knots[n],
-                                st.times[count - 1] - st.times[count - 2],
-                                next.times[1] - next.times[0]));
+    scale.push_back(junction_scale(sim.robot, options, steps[k], steps[k + 1]));
     if (scale.back() == 0) return std::nullopt;
   }
   Joined j = join_steps(steps, 0, parts - 1, scale, n);
@@ -738,18 +748,9 @@ std::optional<PathStep> blended_step_through(const Simulator& sim, SimulatorWork
   step.knots = std::move(j.knots);
   step.knot_times = std::move(j.times);
   step.command_duration = step.knot_times.back();
-  const int last = static_cast<int>(step.knot_times.size()) - 1;
-  for (int round = 0;; ++round) {
-    step.outcome_rows.clear();
-    step.outcome = simulate(sim, ws, points.front(), step.profile(n),
-                            {nullptr, nullptr, 0, &step.outcome_rows});
-    if (simulations) *simulations = round + 1;
-    if (round >= kDirectCorrections || !step.outcome->valid() ||
-        land_in.contains(sim.robot, ws.robot, step.outcome->qf))
-      return step;
-    correct_command(step.knot_times, step.knots, j.last_step_first_knot, last,
-                    points.back() - step.outcome->qf);
-  }
+  land(sim, ws, points.front(), points.back(), &land_in, step.knot_times, j.last_step_first_knot,
+       step, simulations);
+  return step;
 }
 
 std::optional<PathStep> direct_step(const Simulator& sim, SimulatorWorkspace& ws,
