@@ -123,8 +123,8 @@ std::vector<Step> raw_steps(const std::vector<PathStep>& steps, const RawChain& 
 
 // Adds `delta` (a displacement, per joint) to the commanded displacement of the knots
 // [first, last) of a command, evenly: knot j carries (t_{j+1} - t_{j-1}) / 2 of the integral.
-void correct_command(std::vector<double>& times, std::vector<double>& knots, int first, int last,
-                     const JointVector& delta) {
+void correct_command(const std::vector<double>& times, std::vector<double>& knots, int first,
+                     int last, const JointVector& delta) {
   const int n = static_cast<int>(delta.size());
   double weight = 0;
   for (int j = first; j < last; ++j) weight += 0.5 * (times[j + 1] - times[j - 1]);
@@ -500,7 +500,6 @@ Attempt try_segment(Work& w, const std::vector<Step>& steps, const RawChain& raw
   return at;
 }
 
-// The blend scale of every junction after step a (0: cannot be blended within the limits).
 // The blend scale of the junction between `st` and `next` (0: none within the limits).
 double junction_scale(const RobotModel& robot, const ExecutionOptions& options, const Step& st,
                       const Step& next) {
@@ -510,6 +509,7 @@ double junction_scale(const RobotModel& robot, const ExecutionOptions& options, 
                      st.times[count - 1] - st.times[count - 2], next.times[1] - next.times[0]);
 }
 
+// The blend scale of every junction after step a (0: cannot be blended within the limits).
 std::vector<double> junction_scales(const Work& w, const std::vector<Step>& steps, int a) {
   std::vector<double> scale;
   for (int s = a; s + 1 < static_cast<int>(steps.size()); ++s) {
@@ -692,8 +692,8 @@ namespace {
 // `land_in` (null: never), corrects knots [first, last) of its command (knot times `times`) by
 // the miss from `target` and simulates again, up to kDirectCorrections times.
 void land(const Simulator& sim, SimulatorWorkspace& ws, const JointVectorRef& from,
-          const JointVector& target, const Goal* land_in, std::vector<double>& times, int first,
-          PathStep& step, int* simulations) {
+          const JointVector& target, const Goal* land_in, const std::vector<double>& times,
+          int first, PathStep& step, int* simulations) {
   const int last = static_cast<int>(times.size()) - 1;
   for (int round = 0;; ++round) {
     step.outcome_rows.clear();

@@ -64,7 +64,7 @@ constexpr double kRejectedCandidate = 0.25;
 // Expansions of a round's first search in a scene other than the bundle's, with the scene's
 // marks in the edge cost, before the round searches without them. 250 rather than 1000 since
 // 2026-12-04 (fifth session): in `shelf.json` the first round's marked search used all 1000
-// and found nothing (80 % of a solve's successors); on eight tuning sets 250 kept up to 56 %
+// and found nothing (82 % of a solve's successors); on eight tuning sets 250 kept up to 56 %
 // fewer predicted states, simulations per plan -38 to +5 % (docs/performance.md).
 constexpr size_t kMarkedSearchLimit = 250;
 // Under a tilt limit (the waiter), predicted states beyond it are left out, and the lazy graph
