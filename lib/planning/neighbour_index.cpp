@@ -122,7 +122,7 @@ template <SearchMode Mode>
 struct Search {
   const KdTreeArrays& tree;
   const double* rows;
-  bool leaf_ordered;  // row i is point order[i] (else row id is point id)
+  bool leaf_ordered;  // rows are Impl::leaf_rows, by leaf and column (else the bundle's rows)
   int dof;
   const double* q;
   double r2, prune;  // prune: r2 with a margin, so that rounding in the bound never drops a point
@@ -132,20 +132,49 @@ struct Search {
   bool found = false;
 
   void leaf(const KdNode& n) {
+    if (leaf_ordered) return leaf_columns(n);
     for (uint32_t i = n.first; i < n.second; ++i) {
-      const double d =
-          squared_distance(q, rows + size_t{leaf_ordered ? i : tree.order[i]} * dof, dof);
-      if constexpr (Mode == SearchMode::Nearest) {
-        // Full of nearest ones, the radius is the farthest kept: a tie may still replace it by id.
-        if (d > r2 || (d == r2 && out->size() < nearest)) continue;
-        keep_nearest(tree.order[i], d);
-      } else {
-        if (d >= r2) continue;
-        found = true;
-        if constexpr (Mode == SearchMode::Any) return;
-        out->emplace_back(tree.order[i], d);
+      if (!take(i, squared_distance(q, rows + size_t{tree.order[i]} * dof, dof))) return;
+    }
+  }
+
+  // A leaf stored by columns (EdgeIndex::Impl::order_rows): its points' distances a block of
+  // kBlock at a time, in loops over the points the compiler vectorises, each summed in joint
+  // order as squared_distance does (the same values to the bit).
+  void leaf_columns(const KdNode& n) {
+    constexpr uint32_t kBlock = 16;
+    const uint32_t count = n.second - n.first;
+    const double* columns = rows + size_t{n.first} * dof;
+    for (uint32_t b = 0; b < count; b += kBlock) {
+      const uint32_t m = std::min(kBlock, count - b);
+      std::array<double, kBlock> d{};
+      for (int k = 0; k < dof; ++k) {
+        const double* column = columns + static_cast<size_t>(k) * count + b;
+        const double qk = q[k];
+        for (uint32_t j = 0; j < m; ++j) {
+          const double diff = qk - column[j];
+          d[j] += diff * diff;
+        }
+      }
+      for (uint32_t j = 0; j < m; ++j) {
+        if (!take(n.first + b + j, d[j])) return;
       }
     }
+  }
+
+  // Point i of the leaf order at squared distance d; false when the search is done (Any).
+  bool take(uint32_t i, double d) {
+    if constexpr (Mode == SearchMode::Nearest) {
+      // Full of nearest ones, the radius is the farthest kept: a tie may still replace it by id.
+      if (d > r2 || (d == r2 && out->size() < nearest)) return true;
+      keep_nearest(tree.order[i], d);
+    } else {
+      if (d >= r2) return true;
+      found = true;
+      if constexpr (Mode == SearchMode::Any) return false;
+      out->emplace_back(tree.order[i], d);
+    }
+    return true;
   }
 
   void keep_nearest(uint32_t id, double d) {
@@ -281,11 +310,20 @@ struct EdgeIndex::Impl {
   // dof doubles per edge; the end index (goal coverage, a few queries a solve) reads the bundle.
   std::vector<double> leaf_rows = {};
 
+  // Each leaf's points are stored by columns: its first joint's values, then its second's...
+  // (Search::leaf_columns reads them a block at a time).
   void order_rows(size_t count) {
     if (rows == nullptr || point != EdgePoint::Start) return;
     leaf_rows.resize(count * static_cast<size_t>(dof));
-    for (size_t i = 0; i < count; ++i)
-      std::copy_n(rows + size_t{arrays.order[i]} * dof, dof, leaf_rows.data() + i * dof);
+    for (uint64_t v = 0; v < arrays.node_count; ++v) {
+      const KdNode& n = arrays.nodes[v];
+      if (n.dim != KdNode::kLeaf) continue;
+      const size_t points = n.second - n.first;
+      double* columns = leaf_rows.data() + size_t{n.first} * dof;
+      for (size_t j = 0; j < points; ++j)
+        for (int k = 0; k < dof; ++k)
+          columns[k * points + j] = rows[size_t{arrays.order[n.first + j]} * dof + k];
+    }
   }
 };
 
