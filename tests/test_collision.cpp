@@ -163,12 +163,37 @@ TEST(Collision, NearTouchingRespectsTheMargin) {
   }
 }
 
-// The fast check (bounding-volume culling, inflated shapes, early exit) must agree with the
-// exact distances: in collision exactly when some tested pair is closer than the margin.
+// Boxes of every size and orientation about the arm (the fast check's capsule-box separating
+// test works in a box's own axes), on a floor.
+Environment turned_boxes(uint64_t seed) {
+  Environment env = env_file("empty");
+  env.path = "generated";
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (int i = 0; i < 10; ++i) {
+    Obstacle o;
+    o.name = "box" + std::to_string(i);
+    o.shape.type = ShapeType::Box;
+    o.shape.size = Eigen::Vector3d(0.12 + 0.1 * u(rng), 0.12 + 0.1 * u(rng), 0.12 + 0.1 * u(rng));
+    o.pose.p = Eigen::Vector3d(0.6 * u(rng), 0.6 * u(rng), 0.5 + 0.4 * u(rng));
+    const Eigen::Vector3d axis = Eigen::Vector3d(u(rng), u(rng), u(rng)).normalized();
+    o.pose.R = Eigen::AngleAxisd(3.14 * u(rng), axis).toRotationMatrix();
+    env.obstacles.push_back(o);
+  }
+  return env;
+}
+
+// The fast check (bounding-volume culling, separating axes, inflated shapes, early exit) must
+// agree with the exact distances: in collision exactly when some tested pair is closer than the
+// margin.
 TEST(Collision, FastCheckAgreesWithExactDistances) {
   const RobotModel& robot = test::panda();
-  for (const char* name : {"table", "shelf"}) {
-    Checker c(robot, env_file(name));
+  const std::vector<std::pair<std::string, Environment>> scenes = {
+      {"table", env_file("table")},
+      {"shelf", env_file("shelf")},
+      {"turned boxes", turned_boxes(7)}};
+  for (const auto& [name, env] : scenes) {
+    Checker c(robot, env);
     std::mt19937_64 rng(21);
     std::uniform_real_distribution<double> u(0, 1);
     int colliding = 0, free = 0, checked = 0;
