@@ -163,18 +163,20 @@ TEST(Collision, NearTouchingRespectsTheMargin) {
   }
 }
 
-// Boxes of every size and orientation about the arm (the fast check's capsule-box separating
-// test works in a box's own axes), on a floor.
-Environment turned_boxes(uint64_t seed) {
+// Boxes and cylinders of every size and orientation about the arm (the fast check's separating
+// test works in an obstacle's own axes), on a floor.
+Environment turned_objects(uint64_t seed) {
   Environment env = env_file("empty");
   env.path = "generated";
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> u(-1, 1);
   for (int i = 0; i < 10; ++i) {
     Obstacle o;
-    o.name = "box" + std::to_string(i);
-    o.shape.type = ShapeType::Box;
+    o.name = "object" + std::to_string(i);
+    o.shape.type = i % 2 == 0 ? ShapeType::Box : ShapeType::Cylinder;
     o.shape.size = Eigen::Vector3d(0.12 + 0.1 * u(rng), 0.12 + 0.1 * u(rng), 0.12 + 0.1 * u(rng));
+    o.shape.radius = 0.06 + 0.05 * u(rng);
+    o.shape.length = 0.12 + 0.1 * u(rng);
     o.pose.p = Eigen::Vector3d(0.6 * u(rng), 0.6 * u(rng), 0.5 + 0.4 * u(rng));
     const Eigen::Vector3d axis = Eigen::Vector3d(u(rng), u(rng), u(rng)).normalized();
     o.pose.R = Eigen::AngleAxisd(3.14 * u(rng), axis).toRotationMatrix();
@@ -191,7 +193,7 @@ TEST(Collision, FastCheckAgreesWithExactDistances) {
   const std::vector<std::pair<std::string, Environment>> scenes = {
       {"table", env_file("table")},
       {"shelf", env_file("shelf")},
-      {"turned boxes", turned_boxes(7)}};
+      {"turned objects", turned_objects(7)}};
   for (const auto& [name, env] : scenes) {
     Checker c(robot, env);
     std::mt19937_64 rng(21);

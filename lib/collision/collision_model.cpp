@@ -256,21 +256,53 @@ bool self_collides(const CollisionShapes& shapes, const CollisionData& data, int
 // pairs that are clearly apart.
 constexpr double kClearlyApart = 1e-6;
 
-// A capsule (robot, grown) and a box (obstacle) one of the box's faces separates: the capsule's
-// segment lies beyond the face's plane by more than its radius. A separating axis, so they do
-// not touch; most pairs whose bounding sphere reaches a box's bounding box are decided here,
-// several times cheaper than GJK. False means only that GJK must decide.
-bool capsule_clear_of_box(const fcl::CollisionGeometryd* capsule, const fcl::Transform3d& tc,
-                          const fcl::CollisionGeometryd* box, const fcl::Transform3d& tb) {
-  if (capsule->getNodeType() != fcl::GEOM_CAPSULE || box->getNodeType() != fcl::GEOM_BOX)
-    return false;
-  const auto& c = *static_cast<const fcl::Capsuled*>(capsule);
-  const Eigen::Vector3d& side = static_cast<const fcl::Boxd*>(box)->side;
-  const Eigen::Matrix3d to_box = tb.linear().transpose();
-  const Eigen::Vector3d centre = to_box * (tc.translation() - tb.translation());
-  const Eigen::Vector3d half_axis = to_box * tc.linear().col(2) * (0.5 * c.lz);
+// A robot shape as a segment with a radius: a capsule's axis (FCL's z, lz long), or a sphere's
+// centre; false for other shapes.
+inline bool as_swept_sphere(const fcl::CollisionGeometryd* g, double& half_length, double& radius) {
+  if (g->getNodeType() == fcl::GEOM_CAPSULE) {
+    const auto& c = *static_cast<const fcl::Capsuled*>(g);
+    half_length = 0.5 * c.lz;
+    radius = c.radius;
+    return true;
+  }
+  if (g->getNodeType() == fcl::GEOM_SPHERE) {
+    half_length = 0;
+    radius = static_cast<const fcl::Sphered*>(g)->radius;
+    return true;
+  }
+  return false;
+}
+
+// An obstacle's box in its own frame, as half sides: a box's own, or the one about a cylinder
+// (FCL's z its axis); false for other shapes.
+inline bool own_box(const fcl::CollisionGeometryd* g, Eigen::Vector3d& half) {
+  if (g->getNodeType() == fcl::GEOM_BOX) {
+    half = 0.5 * static_cast<const fcl::Boxd*>(g)->side;
+    return true;
+  }
+  if (g->getNodeType() == fcl::GEOM_CYLINDER) {
+    const auto& c = *static_cast<const fcl::Cylinderd*>(g);
+    half = Eigen::Vector3d(c.radius, c.radius, 0.5 * c.lz);
+    return true;
+  }
+  return false;
+}
+
+// A robot capsule or sphere (grown) and an obstacle box or cylinder that one face of the
+// obstacle's own box separates: the robot shape's segment lies beyond the face's plane by more
+// than its radius. A separating axis, so they do not touch; most pairs whose bounding sphere
+// reaches an obstacle's bounding box are decided here, several times cheaper than GJK. False
+// means only that GJK must decide.
+bool clearly_apart(const fcl::CollisionGeometryd* shape, const fcl::Transform3d& ts,
+                   const fcl::CollisionGeometryd* obstacle, const fcl::Transform3d& to) {
+  double half_length = 0, radius = 0;
+  Eigen::Vector3d half;
+  if (!as_swept_sphere(shape, half_length, radius) || !own_box(obstacle, half)) return false;
+  const Eigen::Matrix3d to_box = to.linear().transpose();
+  const Eigen::Vector3d centre = to_box * (ts.translation() - to.translation());
+  const Eigen::Vector3d half_axis = to_box * ts.linear().col(2) * half_length;
   for (int i = 0; i < 3; ++i) {
-    const double reach = 0.5 * side[i] + c.radius + kClearlyApart + std::abs(half_axis[i]);
+    const double reach = half[i] + radius + kClearlyApart + std::abs(half_axis[i]);
     if (std::abs(centre[i]) > reach) return true;
   }
   return false;
@@ -289,8 +321,7 @@ bool env_collides(const CollisionShapes& shapes, const CollisionData& data, int 
   if (!obstacle.primitive)
     return collide_with_bvh(data, robot.inflated, data.transform[a], obstacle.geometry,
                             obstacle.transform);
-  if (capsule_clear_of_box(robot.inflated, data.transform[a], obstacle.geometry,
-                           obstacle.transform))
+  if (clearly_apart(robot.inflated, data.transform[a], obstacle.geometry, obstacle.transform))
     return false;
   return narrow_collide(robot.inflated, data.transform[a], obstacle.geometry, obstacle.transform);
 }
