@@ -14,6 +14,7 @@
 #include "lazyboe/bundle/bundle_file.h"
 #include "lazyboe/common/error.h"
 #include "lazyboe/common/hash.h"
+#include "lazyboe/common/huge_pages.h"
 #include "lazyboe/planning/edge_index_file.h"
 #include "lazyboe/planning/planners/neighbour_memo.h"
 #include "test_util.h"
@@ -157,6 +158,24 @@ TEST(EdgeIndex, TinyAndEmptyBundles) {
     index.nearest(q.data(), 0, 100, found);
     EXPECT_TRUE(found.empty());
   }
+}
+
+// The index's private copy of its points (HugePageArray): whole huge pages, aligned to one,
+// holding what was written; a move leaves the source empty.
+TEST(EdgeIndex, HugePageArrayHoldsItsValuesOnAlignedPages) {
+  HugePageArray<double> a(300000);
+  ASSERT_EQ(a.size(), 300000u);
+  EXPECT_EQ(reinterpret_cast<uintptr_t>(a.data()) % HugePageArray<double>::kHugePage, 0u);
+  for (size_t i = 0; i < a.size(); ++i) a.data()[i] = static_cast<double>(i) * 0.5;
+  HugePageArray<double> b(std::move(a));
+  EXPECT_TRUE(a.empty());
+  EXPECT_EQ(a.data(), nullptr);
+  ASSERT_EQ(b.size(), 300000u);
+  EXPECT_EQ(b.data()[299999], 299999 * 0.5);
+  HugePageArray<double> c;
+  c = std::move(b);
+  EXPECT_EQ(c.data()[12345], 12345 * 0.5);
+  EXPECT_TRUE(HugePageArray<double>(0).empty());
 }
 
 TEST(EdgeIndexFile, WrittenIndexIsMappedAndAnswersAsTheBuiltTrees) {

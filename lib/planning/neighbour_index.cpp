@@ -6,6 +6,7 @@
 #include <string>
 
 #include "lazyboe/common/error.h"
+#include "lazyboe/common/huge_pages.h"
 #include "lazyboe/robot/types.h"
 
 namespace lazyboe {
@@ -308,13 +309,13 @@ struct EdgeIndex::Impl {
   // solve) keeps its points again in leaf order, so that a leaf's scan reads contiguous memory
   // instead of rows spread over the bundle: cache misses were most of a radius query's time.
   // dof doubles per edge; the end index (goal coverage, a few queries a solve) reads the bundle.
-  std::vector<double> leaf_rows = {};
+  HugePageArray<double> leaf_rows = {};
 
   // Each leaf's points are stored by columns: its first joint's values, then its second's...
   // (Search::leaf_columns reads them a block at a time).
   void order_rows(size_t count) {
     if (rows == nullptr || point != EdgePoint::Start) return;
-    leaf_rows.resize(count * static_cast<size_t>(dof));
+    leaf_rows = HugePageArray<double>(count * static_cast<size_t>(dof));
     for (uint64_t v = 0; v < arrays.node_count; ++v) {
       const KdNode& n = arrays.nodes[v];
       if (n.dim != KdNode::kLeaf) continue;
