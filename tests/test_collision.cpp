@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <random>
+#include <tuple>
 
 #include "lazyboe/collision/allowed_pairs.h"
 #include "lazyboe/collision/collision_model.h"
@@ -189,12 +190,18 @@ Environment turned_objects(uint64_t seed) {
 // agree with the exact distances: in collision exactly when some tested pair is closer than the
 // margin.
 TEST(Collision, FastCheckAgreesWithExactDistances) {
-  const RobotModel& robot = test::panda();
-  const std::vector<std::pair<std::string, Environment>> scenes = {
-      {"table", env_file("table")},
-      {"shelf", env_file("shelf")},
-      {"turned objects", turned_objects(7)}};
-  for (const auto& [name, env] : scenes) {
+  const RobotModel& panda = test::panda();
+  // The Panda's shapes are all capsules: a copy with spheres for its last three.
+  RobotModel spheres = panda;
+  for (size_t b = spheres.geometry.bodies.size() - 3; b < spheres.geometry.bodies.size(); ++b)
+    spheres.geometry.bodies[b].shape.type = ShapeType::Sphere;
+  const std::vector<std::tuple<std::string, const RobotModel*, Environment>> scenes = {
+      {"table", &panda, env_file("table")},
+      {"shelf", &panda, env_file("shelf")},
+      {"turned objects", &panda, turned_objects(7)},
+      {"turned objects, spheres", &spheres, turned_objects(7)}};
+  for (const auto& [name, robot_model, env] : scenes) {
+    const RobotModel& robot = *robot_model;
     Checker c(robot, env);
     std::mt19937_64 rng(21);
     std::uniform_real_distribution<double> u(0, 1);

@@ -9,7 +9,9 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <numeric>
 #include <random>
+#include <tuple>
 
 #include "lazyboe/bundle/bundle_file.h"
 #include "lazyboe/common/error.h"
@@ -160,8 +162,37 @@ TEST(EdgeIndex, TinyAndEmptyBundles) {
   }
 }
 
+// Leaves of more than 16 points (the start tree scans them by columns, 16 at a time): 60 edges
+// that start at one state, which no split separates, and a tree as an index file may hold it,
+// one leaf of every point.
+TEST(EdgeIndex, LeavesOfManyPointsAnswerAsAScan) {
+  Bundle b = test::viewable_bundle(500, 7, 4);
+  for (size_t e = 1; e < 60; ++e) std::memcpy(b.q0.data() + 7 * e, b.q0.data(), 7 * sizeof(double));
+  const BundleView v = BundleView::from_memory(std::make_shared<const Bundle>(b), "mem");
+  expect_scan_results(v, EdgeIndex(v));
+
+  auto one_leaf = std::make_shared<std::vector<KdNode>>(1);
+  (*one_leaf)[0].first = 0;
+  (*one_leaf)[0].second = static_cast<uint32_t>(v.size());
+  auto order = std::make_shared<std::vector<uint32_t>>(v.size());
+  std::iota(order->begin(), order->end(), 0u);
+  auto box = std::make_shared<std::vector<double>>(14);
+  for (int k = 0; k < 7; ++k) {
+    (*box)[k] = (*box)[7 + k] = v.q0(0)[k];
+    for (size_t e = 0; e < v.size(); ++e) {
+      (*box)[k] = std::min((*box)[k], v.q0(e)[k]);
+      (*box)[7 + k] = std::max((*box)[7 + k], v.q0(e)[k]);
+    }
+  }
+  const KdTreeArrays arrays{one_leaf->data(), 1, order->data(), box->data(), box->data() + 7};
+  const auto storage =
+      std::make_shared<std::tuple<decltype(one_leaf), decltype(order), decltype(box)>>(one_leaf,
+                                                                                       order, box);
+  expect_scan_results(v, EdgeIndex(v, EdgePoint::Start, arrays, storage, "one leaf"));
+}
+
 // The index's private copy of its points (HugePageArray): whole huge pages, aligned to one,
-// holding what was written; a move leaves the source empty.
+// holding what was written; a move (construction or assignment) leaves the source empty.
 TEST(EdgeIndex, HugePageArrayHoldsItsValuesOnAlignedPages) {
   HugePageArray<double> a(300000);
   ASSERT_EQ(a.size(), 300000u);
@@ -172,8 +203,10 @@ TEST(EdgeIndex, HugePageArrayHoldsItsValuesOnAlignedPages) {
   EXPECT_EQ(a.data(), nullptr);
   ASSERT_EQ(b.size(), 300000u);
   EXPECT_EQ(b.data()[299999], 299999 * 0.5);
-  HugePageArray<double> c;
+  HugePageArray<double> c(10);
   c = std::move(b);
+  EXPECT_TRUE(b.empty());
+  EXPECT_EQ(b.data(), nullptr);
   EXPECT_EQ(c.data()[12345], 12345 * 0.5);
   EXPECT_TRUE(HugePageArray<double>(0).empty());
 }

@@ -1,11 +1,12 @@
 // An array of plain values in memory the kernel may back with huge pages (Linux transparent
-// huge pages, asked for with madvise): for the few megabytes that searches read at random
-// places thousands of times a query (the k-d index's points, the edges' displacements), where
-// the misses of the address translation with 4 KiB pages were much of the time. Elsewhere, or
-// when the kernel declines, it is ordinary memory.
+// huge pages, asked for with madvise): for the few megabytes that searches read at scattered
+// places thousands of times a query (the k-d index's copy of its points), where the misses of
+// the address translation with 4 KiB pages cost much of the time. Elsewhere, or when the
+// kernel declines, it is ordinary memory.
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <cstdlib>
 #include <new>
 #include <type_traits>
@@ -23,12 +24,14 @@ class HugePageArray {
                 "plain values only: the memory is neither constructed nor destroyed");
 
  public:
+  // x86-64's huge page (and aarch64's with 4 KiB pages); elsewhere only an alignment.
   static constexpr size_t kHugePage = size_t{2} << 20;
 
   HugePageArray() = default;
   // `count` values, uninitialised.
   explicit HugePageArray(size_t count) : size_(count) {
     if (count == 0) return;
+    if (count > (SIZE_MAX - kHugePage) / sizeof(T)) throw std::bad_alloc();
     const size_t bytes = (count * sizeof(T) + kHugePage - 1) / kHugePage * kHugePage;
     data_ = static_cast<T*>(std::aligned_alloc(kHugePage, bytes));
     if (data_ == nullptr) throw std::bad_alloc();
@@ -42,8 +45,10 @@ class HugePageArray {
     other.size_ = 0;
   }
   HugePageArray& operator=(HugePageArray&& other) noexcept {
-    std::swap(data_, other.data_);
-    std::swap(size_, other.size_);
+    if (this == &other) return *this;
+    std::free(data_);
+    data_ = std::exchange(other.data_, nullptr);
+    size_ = std::exchange(other.size_, 0);
     return *this;
   }
   HugePageArray(const HugePageArray&) = delete;

@@ -59,8 +59,9 @@ struct KdTreeArrays {
 };
 
 // An index over the edge starts (the planners' neighbourhoods, queried thousands of times a
-// solve) also keeps a copy of its points in leaf order: dof doubles per edge of private memory
-// for radius queries that read contiguous memory rather than rows spread over the bundle.
+// solve) also keeps a copy of its points in leaf order, each leaf's by joint: dof doubles per
+// edge of private memory for radius queries that read contiguous memory rather than rows
+// spread over the bundle.
 class EdgeIndex {
  public:
   static constexpr uint32_t kLeafSize = 16;
