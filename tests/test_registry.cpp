@@ -103,8 +103,8 @@ TEST(Registry, NamesAndLookups) {
                                    "pruning_ratio", "epsilon", "resolution", "risk_weight",
                                    "edge_penalty", "expansion_limit", "mark_weight", "direct",
                                    "connect_radius", "candidate_radius", "precheck", "approaches",
-                                   "goal_look", "candidate_shortcut"}));
-  EXPECT_EQ(all.size(), 18u);  // each once
+                                   "goal_look", "candidate_shortcut", "look_again"}));
+  EXPECT_EQ(all.size(), 19u);  // each once
 }
 
 // The refusals only: a planner registered here would stay for the other tests of a process that
