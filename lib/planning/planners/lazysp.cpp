@@ -157,6 +157,8 @@ class LazySpSearch {
   }
   int expand(int p);
   bool push(Predicted x, double h);
+  // A state's place in the open list: f = g + epsilon h, h counting the edge penalty.
+  double priority(double g, double h) const { return g + set_.epsilon * h * h_scale_; }
   // Whether g is the cheapest so far in `cell` (then recorded as such).
   bool improves(uint64_t cell, double g);
   void enqueue(Predicted x, double h);
@@ -305,7 +307,6 @@ class LazySpSearch {
   std::vector<Predicted> preds_;
   std::vector<int> chain_ids_;  // the candidate's states, as indices into preds_
   std::vector<char> dropped_;   // by index into preds_: left out by go_on_without
-  size_t search_limit_ = 0;     // the expansions the round's current search may take
   std::priority_queue<std::pair<double, int>, std::vector<std::pair<double, int>>, std::greater<>>
       open_;
   std::unordered_map<uint64_t, double> best_in_cell_;
@@ -404,7 +405,6 @@ void LazySpSearch::lazy_round() {
 bool LazySpSearch::candidate(size_t& expansions, size_t limit, bool use_marks,
                              std::vector<Predicted>& chain) {
   use_marks_ = use_marks;
-  search_limit_ = limit;
   return chain_to(search(expansions, limit), chain);
 }
 
@@ -434,8 +434,10 @@ bool LazySpSearch::go_on_without(size_t blocked, size_t& expansions,
   const auto record = best_in_cell_.find(preds_[end].cell);
   if (record != best_in_cell_.end() && record->second == preds_[end].g) best_in_cell_.erase(record);
   const Predicted& from = preds_[start];
-  open_.emplace(from.g + set_.epsilon * lazy_h(from.q) * h_scale_, start);
-  return chain_to(go_on(expansions, search_limit_), chain);
+  open_.emplace(priority(from.g, lazy_h(from.q)), start);
+  // The limit of the search that found the candidate (lazy_round's two).
+  const size_t limit = use_marks_ ? kMarkedSearchLimit : set_.expansion_limit;
+  return chain_to(go_on(expansions, limit), chain);
 }
 
 // Weighted A* (f = g + epsilon h) from every real node at once, each with its real cost, over
@@ -555,7 +557,7 @@ bool LazySpSearch::improves(uint64_t cell, double g) {
 }
 
 void LazySpSearch::enqueue(Predicted x, double h) {
-  open_.emplace(x.g + set_.epsilon * h * h_scale_, static_cast<int>(preds_.size()));
+  open_.emplace(priority(x.g, h), static_cast<int>(preds_.size()));
   preds_.push_back(std::move(x));
 }
 
