@@ -79,7 +79,9 @@ constexpr double kTiltWidening = 1.5;
 // measured before the looks counted as lazy work: against no look, the geometric means over the
 // sets of the median time to an executable trajectory were 0.92 / 0.96 / 0.92 and of the mean
 // time to first solution (a miss 5 s) 1.02 / 0.93 / 0.86. Halving it after each round that used
-// it up, or a limit in expansions instead, did no better.
+// it up, or a limit in expansions instead, did no better. Since look_again a round holds up to 51
+// candidates, which share it: a limit per candidate, 512 or 1024 per round did no better either
+// (the shelves gained what the board scenes lost; docs/performance.md, seventh session).
 constexpr int kGoalLineRejections = 256;
 // Bytes the memo of the lazy search's radius queries may hold before it starts again empty
 // (a failing 5 s solve on the 100k table bundle expands about 10^5 states of tens of edges).
@@ -147,14 +149,9 @@ class LazySpSearch {
   int search(size_t& expansions, size_t limit);
   int go_on(size_t& expansions, size_t limit);
   bool go_on_without(size_t blocked, size_t& expansions, std::vector<Predicted>& chain);
-  // Whether predicted state p lies below an edge the look rejected in this search
-  // (go_on_without).
-  bool dropped(int p) const {
-    if (dropped_.empty()) return false;
-    for (int u = p; u >= 0; u = preds_[u].parent)
-      if (static_cast<size_t>(u) < dropped_.size() && dropped_[u]) return true;
-    return false;
-  }
+  // Whether predicted state p lies below an edge the look rejected in this search (drop_below).
+  bool dropped(int p) const { return static_cast<size_t>(p) < dropped_.size() && dropped_[p]; }
+  void drop_below(int end);
   int expand(int p);
   bool push(Predicted x, double h);
   // A state's place in the open list: f = g + epsilon h, h counting the edge penalty.
@@ -423,21 +420,33 @@ bool LazySpSearch::chain_to(int goal, std::vector<Predicted>& chain) {
 
 // The look rejected the candidate's edge `blocked` (blocked_edge, which left it out from its
 // start's cell): the search goes on where it was instead of starting again (look_again). The
-// edge's predicted end is dropped, and with it every state planned through it; its cell is free
-// again (unless a cheaper state holds it); its start is expanded again, now without that edge.
+// edge's predicted end is dropped, and with it every state planned through it (drop_below);
+// their cells are free again; its start is expanded again, now without that edge.
 // The next candidate, within the search's limit, or false.
 bool LazySpSearch::go_on_without(size_t blocked, size_t& expansions,
                                  std::vector<Predicted>& chain) {
   const int end = chain_ids_[blocked], start = chain_ids_[blocked - 1];
-  dropped_.resize(preds_.size(), 0);
-  dropped_[end] = 1;
-  const auto record = best_in_cell_.find(preds_[end].cell);
-  if (record != best_in_cell_.end() && record->second == preds_[end].g) best_in_cell_.erase(record);
+  drop_below(end);
   const Predicted& from = preds_[start];
   open_.emplace(priority(from.g, lazy_h(from.q)), start);
   // The limit of the search that found the candidate (lazy_round's two).
   const size_t limit = use_marks_ ? kMarkedSearchLimit : set_.expansion_limit;
   return chain_to(go_on(expansions, limit), chain);
+}
+
+// Drops predicted state `end` and every state planned through it (a state comes after its parent
+// in preds_), and frees the cells they hold (unless a cheaper state took one), so that states
+// generated later may take them.
+void LazySpSearch::drop_below(int end) {
+  dropped_.resize(preds_.size(), 0);
+  dropped_[end] = 1;
+  for (size_t p = end; p < preds_.size(); ++p) {
+    const Predicted& x = preds_[p];
+    if (!dropped_[p] && !(x.parent >= 0 && dropped_[x.parent])) continue;
+    dropped_[p] = 1;
+    const auto record = best_in_cell_.find(x.cell);
+    if (record != best_in_cell_.end() && record->second == x.g) best_in_cell_.erase(record);
+  }
 }
 
 // Weighted A* (f = g + epsilon h) from every real node at once, each with its real cost, over
