@@ -288,11 +288,12 @@ inline bool own_box(const fcl::CollisionGeometryd* g, Eigen::Vector3d& half) {
   return false;
 }
 
-// A robot capsule or sphere (grown) and an obstacle box or cylinder that one face of the
-// obstacle's own box separates: the robot shape's segment lies beyond the face's plane by more
-// than its radius. A separating axis, so they do not touch; most pairs whose bounding sphere
-// reaches an obstacle's bounding box are decided here, several times cheaper than GJK. False
-// means only that GJK must decide.
+// A robot capsule or sphere (grown) and an obstacle box or cylinder that a separating axis
+// keeps apart by more than the shape's radius: a face normal of the obstacle's own box, or (for
+// a capsule) its segment's direction crossed with one (the six axes of a segment against a box).
+// Most pairs whose bounding sphere reaches an obstacle's bounding box are decided here, several
+// times cheaper than GJK. False means only that GJK must decide (a capsule passing a corner of
+// the box, whose separating direction is none of these).
 bool clearly_apart(const fcl::CollisionGeometryd* shape, const fcl::Transform3d& ts,
                    const fcl::CollisionGeometryd* obstacle, const fcl::Transform3d& to) {
   double half_length = 0, radius = 0;
@@ -300,10 +301,22 @@ bool clearly_apart(const fcl::CollisionGeometryd* shape, const fcl::Transform3d&
   if (!as_swept_sphere(shape, half_length, radius) || !own_box(obstacle, half)) return false;
   const Eigen::Matrix3d to_box = to.linear().transpose();
   const Eigen::Vector3d centre = to_box * (ts.translation() - to.translation());
-  const Eigen::Vector3d half_axis = to_box * ts.linear().col(2) * half_length;
+  const Eigen::Vector3d axis = to_box * ts.linear().col(2);  // unit
+  const double grown = radius + kClearlyApart;
   for (int i = 0; i < 3; ++i) {
-    const double reach = half[i] + radius + kClearlyApart + std::abs(half_axis[i]);
+    const double reach = half[i] + grown + std::abs(axis[i]) * half_length;
     if (std::abs(centre[i]) > reach) return true;
+  }
+  if (half_length == 0) return false;
+  // The axes across the segment (its direction x each box axis): the segment projects onto
+  // one to a point, the box to sum_j half_j |L_j|, the robot shape's radius to radius |L|.
+  for (int i = 0; i < 3; ++i) {
+    const int j = (i + 1) % 3, k = (i + 2) % 3;
+    const double lj = axis[k], lk = -axis[j];  // L = axis x e_i, whose own component is 0
+    const double length = std::sqrt(lj * lj + lk * lk);
+    if (length < 1e-9) continue;  // the segment along e_i: the faces above decide
+    const double reach = half[j] * std::abs(lj) + half[k] * std::abs(lk) + grown * length;
+    if (std::abs(centre[j] * lj + centre[k] * lk) > reach) return true;
   }
   return false;
 }
