@@ -12,6 +12,7 @@
 #include <functional>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "lazyboe/planning/execution.h"
@@ -71,6 +72,8 @@ class SearchState {
   std::vector<Node>& nodes() { return nodes_; }
   Node& node(int v) { return nodes_[v]; }
   PlanResult& result() { return result_; }
+  // The result, moved out (its path holds every step's per-tick rows): a search's last call.
+  PlanResult take_result() { return std::move(result_); }
 
   double heuristic(const JointVectorRef& q) {
     return problem_.goal.distance(ctx_.sim.robot, goal_data_, q);

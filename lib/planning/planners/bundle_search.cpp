@@ -138,12 +138,12 @@ double BundleSearch::heuristic_at_end(uint32_t e) {
 }
 
 PlanResult BundleSearch::run() {
-  if (direct_ && s_.connect_directly()) return s_.result();
+  if (direct_ && s_.connect_directly()) return s_.take_result();
   BundleNode root;
   root.q = s_.problem().start;
   root.h = s_.heuristic(root.q);
   push(s_.add(root));
-  if (!covered()) return s_.result();
+  if (!covered()) return s_.take_result();
   Neighbours neighbours;
   while (!s_.should_stop()) {
     const int v = pop();
@@ -159,7 +159,7 @@ PlanResult BundleSearch::run() {
                                 "(try lazysp, whose growth leaves the bundle, or a larger theta)"
                               : s_.stop_failure();
   }
-  return r;
+  return s_.take_result();
 }
 
 // Coverage: a start or goal the bundle cannot reach is a clear failure, not a timeout.

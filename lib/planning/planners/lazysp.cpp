@@ -322,7 +322,7 @@ class LazySpSearch {
 };
 
 PlanResult LazySpSearch::run() {
-  if (set_.direct && s_.connect_directly(set_.precheck)) return s_.result();
+  if (set_.direct && s_.connect_directly(set_.precheck)) return s_.take_result();
   RolloutResult at_start;
   at_start.qf = s_.problem().start;
   add_real(at_start, -1, -1, -1);
@@ -342,7 +342,7 @@ PlanResult LazySpSearch::run() {
   }
   PlanResult& r = s_.result();
   if (!r.success) r.failure = s_.stop_failure();
-  return r;
+  return s_.take_result();
 }
 
 // The lazy part runs first and while it has not used more than its share; after a round

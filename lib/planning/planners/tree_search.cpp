@@ -61,7 +61,7 @@ PlanResult TreeSearch::run() {
   }
   PlanResult& result = s_.result();
   if (!result.success) result.failure = s_.stop_failure();
-  return result;
+  return s_.take_result();
 }
 
 void sample_state(const PlanningContext& ctx, const PlanningProblem& p, double goal_bias,
