@@ -80,8 +80,9 @@ constexpr double kTiltWidening = 1.5;
 // sets of the median time to an executable trajectory were 0.92 / 0.96 / 0.92 and of the mean
 // time to first solution (a miss 5 s) 1.02 / 0.93 / 0.86. Halving it after each round that used
 // it up, or a limit in expansions instead, did no better. Since look_again a round holds up to 51
-// candidates, which share it: a limit per candidate, 512 or 1024 per round did no better either
-// (the shelves gained what the board scenes lost; docs/performance.md, seventh session).
+// candidates, which share it. A limit per candidate took simulations from the shelves and gave
+// them to the board scenes; 512 per round saved 3 % of the simulations and its looks cost as
+// much time (docs/performance.md, seventh session).
 constexpr int kGoalLineRejections = 256;
 // Bytes the memo of the lazy search's radius queries may hold before it starts again empty
 // (a failing 5 s solve on the 100k table bundle expands about 10^5 states of tens of edges).
@@ -439,13 +440,15 @@ bool LazySpSearch::go_on_without(size_t blocked, size_t& expansions,
 // generated later may take them.
 void LazySpSearch::drop_below(int end) {
   dropped_.resize(preds_.size(), 0);
-  dropped_[end] = 1;
-  for (size_t p = end; p < preds_.size(); ++p) {
-    const Predicted& x = preds_[p];
-    if (!dropped_[p] && !(x.parent >= 0 && dropped_[x.parent])) continue;
+  const auto drop = [this](size_t p) {
     dropped_[p] = 1;
-    const auto record = best_in_cell_.find(x.cell);
-    if (record != best_in_cell_.end() && record->second == x.g) best_in_cell_.erase(record);
+    const auto record = best_in_cell_.find(preds_[p].cell);
+    if (record != best_in_cell_.end() && record->second == preds_[p].g) best_in_cell_.erase(record);
+  };
+  drop(end);
+  for (size_t p = end + 1; p < preds_.size(); ++p) {  // one dropped before was freed then
+    const int parent = preds_[p].parent;
+    if (!dropped_[p] && parent >= 0 && dropped_[parent]) drop(p);
   }
 }
 
