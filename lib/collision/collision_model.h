@@ -1,8 +1,9 @@
 // Self- and environment collision of the robot with FCL. The FCL shapes and the list of pairs
 // to test are built once (CollisionModel, read-only, shared by threads); a query only moves
 // transforms in a per-thread CollisionData. Bounding spheres (robot) and boxes (obstacles)
-// cull most pairs, and for a robot capsule or sphere against an obstacle box or cylinder a face
-// of the obstacle's own box that separates them most of the rest, before FCL's narrow phase.
+// cull most pairs, and for a robot capsule or sphere against an obstacle box or cylinder a
+// separating axis (a face normal of the obstacle's own box, or the capsule's direction crossed
+// with one) most of the rest, before FCL's narrow phase.
 //
 // Margin: a configuration is in collision when any tested pair is closer than the robot's
 // collision margin. One side of each pair is inflated by the margin, which is exact for

@@ -304,7 +304,7 @@ class LazySpSearch {
   // One round of the lazy search (rebuilt every round from the real nodes).
   std::vector<Predicted> preds_;
   std::vector<int> chain_ids_;  // the candidate's states, as indices into preds_
-  std::vector<char> dropped_;   // by index into preds_: left out by go_on_without
+  std::vector<char> dropped_;   // by index into preds_: left out by drop_below
   std::priority_queue<std::pair<double, int>, std::vector<std::pair<double, int>>, std::greater<>>
       open_;
   std::unordered_map<uint64_t, double> best_in_cell_;
