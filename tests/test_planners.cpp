@@ -993,6 +993,57 @@ TEST(LazySp, ACandidateThatLooksFreeIsSimulatedAsItsShortcut) {
             << " edges take " << edge_seconds << " s in " << edges.counters.simulations << "\n";
 }
 
+// Where the direct command is blocked (a ball on the joint-space line a -> c), lazysp first tries
+// straight commands through one sampled waypoint, blended into one (parameter `waypoints`):
+// found_by "waypoint", no lazy search, one step the post-processing keeps without a simulation.
+// Without waypoints the search answers.
+TEST(LazySp, ABlockedDirectCommandIsTriedThroughAWaypointBeforeAnySearch) {
+  const Fixture& f = fixture();
+  PlanningProblem p = library_problem(f.a, f.c, 10);
+  p.termination.stop_at_first = true;
+  const std::unique_ptr<BlockedScene> scene = scene_with_ball(f, 0.5 * (f.a + f.c), 0.04);
+  const Simulator& blocked = scene->sim;
+  SimulatorWorkspace ws(blocked);
+  ASSERT_FALSE(line_looks_free(blocked, ws, p.start, p.goal.q)) << "the ball misses the line";
+  const PlanningContext context = session_context(f, blocked);
+  const PlanResult r = plan(context, ws, "lazysp", {}, p);
+  ASSERT_TRUE(r.success) << r.failure;
+  EXPECT_EQ(r.found_by, "waypoint");
+  EXPECT_EQ(r.counters.lazy_edges, 0u);
+  EXPECT_LE(r.counters.simulations, 4u);
+  ASSERT_EQ(r.best_path.size(), 1u);
+  const PathStep& step = r.best_path[0];
+  EXPECT_EQ(step.bundle_edge, -1);
+  ASSERT_EQ(step.knot_times.size() * f.sim.robot.dof, step.knots.size());
+  EXPECT_GE(step.knot_times.size(), 3u) << "not a command through a waypoint";
+  expect_revalidated(f, blocked, p, r);
+  ExecutionOptions options;
+  options.limits = context.command;
+  const ExecutableTrajectory e =
+      make_executable(blocked, ws, p.start, r.best_path, p.goal, options, kSampleEvery);
+  EXPECT_EQ(e.stats.simulations, 0);
+
+  const PlanResult again = plan(context, ws, "lazysp", {}, p);
+  ASSERT_TRUE(again.success && again.best_path.size() == 1u) << again.failure;
+  EXPECT_EQ(again.best_path[0].knots, step.knots) << "the same seed drew other waypoints";
+  const PlanResult without = plan(context, ws, "lazysp", {{"waypoints", 0}}, p);
+  ASSERT_TRUE(without.success) << without.failure;
+  EXPECT_NE(without.found_by, "waypoint");
+  EXPECT_GT(without.counters.lazy_edges, 0u);
+  // Waypoints need the direct command's turn and the look at lines.
+  for (const char* off : {"direct", "precheck"})
+    EXPECT_NE(plan(context, ws, "lazysp", {{off, 0}}, p).found_by, "waypoint") << off;
+  // Anytime (no stop_at_first): a waypoint's answer does not end the solve, the search goes on.
+  PlanningProblem anytime = library_problem(f.a, f.c, 0.3);
+  const PlanResult longer = plan(context, ws, "lazysp", {}, anytime);
+  ASSERT_TRUE(longer.success) << longer.failure;
+  EXPECT_GT(longer.counters.lazy_edges, 0u);
+  EXPECT_LE(longer.best_cost, r.best_cost);
+  std::cout << "[ lazysp  ] waypoint: " << r.counters.simulations << " simulations, "
+            << r.counters.collision_checks << " checks; without waypoints "
+            << without.counters.simulations << " simulations (" << without.found_by << ")\n";
+}
+
 // When the look rejects a candidate, the round's search goes on without the rejected edge and
 // what was planned through it (look_again) instead of starting again from every real node: in a
 // scene whose ball the bundle's edges run into, it keeps fewer predicted states, and its answer

@@ -98,13 +98,14 @@ TEST(Registry, NamesAndLookups) {
   EXPECT_TRUE(find_planner("lazysp")->needs.bundle);
   EXPECT_FALSE(find_planner("lazysp")->needs.perturbation);
   const std::vector<std::string> all = all_parameter_names();
-  EXPECT_EQ(std::set<std::string>(all.begin(), all.end()),
-            (std::set<std::string>{"theta", "lazy_model", "goal_bias", "selection_radius",
-                                   "pruning_ratio", "epsilon", "resolution", "risk_weight",
-                                   "edge_penalty", "expansion_limit", "mark_weight", "direct",
-                                   "connect_radius", "candidate_radius", "precheck", "approaches",
-                                   "goal_look", "candidate_shortcut", "look_again"}));
-  EXPECT_EQ(all.size(), 19u);  // each once
+  EXPECT_EQ(
+      std::set<std::string>(all.begin(), all.end()),
+      (std::set<std::string>{
+          "theta",       "lazy_model", "goal_bias",          "selection_radius", "pruning_ratio",
+          "epsilon",     "resolution", "risk_weight",        "edge_penalty",     "expansion_limit",
+          "mark_weight", "direct",     "connect_radius",     "candidate_radius", "precheck",
+          "approaches",  "goal_look",  "candidate_shortcut", "look_again",       "waypoints"}));
+  EXPECT_EQ(all.size(), 20u);  // each once
 }
 
 // The refusals only: a planner registered here would stay for the other tests of a process that

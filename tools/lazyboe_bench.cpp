@@ -147,8 +147,9 @@ void add_options(CLI::App& app, BenchOptions& o) {
                "Do not post-process returned paths (runs.csv's execution columns are then the "
                "raw chain's)");
   app.add_flag("--no-direct", o.no_direct,
-               "The bundle planners search every problem (their parameter direct = false): the "
-               "study measures their searches, also on problems one straight command solves");
+               "The bundle planners search every problem (their parameter direct = false, which "
+               "also turns off lazysp's waypoints): the study measures their searches, also on "
+               "problems one straight command, or two through a waypoint, solve");
   app.add_option("--shortcut-attempts", o.shortcut_attempts,
                  "Post-processing budget: direct commands tried per path (0: junction blending "
                  "only)")

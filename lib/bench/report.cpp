@@ -233,7 +233,8 @@ struct PlannerStats {
   std::vector<double> duration, raw_duration, stops, raw_stops, arc_length, post_seconds,
       ttfs_with_post;
   long junctions = 0, blends_kept = 0, shortcuts = 0;
-  size_t direct = 0;  // solved by the straight command tried before the search
+  size_t direct = 0;    // solved by the straight command tried before the search
+  size_t waypoint = 0;  // by lazysp's straight commands through one waypoint, tried next
 };
 
 std::string fixed(double value, int digits) {
@@ -318,12 +319,13 @@ void write_execution(std::ostream& md, std::map<std::string, PlannerStats>& stat
         "simulation of each step, OMPL's do not (their chain is simulated again). Time to an "
         "executable trajectory: time to first solution plus post-processing. Direct: runs a "
         "bundle planner answered with the straight command it tries before searching (none "
-        "with --no-direct).\n\n";
+        "with --no-direct); waypoint: runs lazysp answered with the straight commands through "
+        "one sampled waypoint it tries next (none with --no-direct).\n\n";
   md << "| planner | median duration (s) | median raw duration (s) | shorter | median stops | "
         "median raw stops | median arc length (rad) | median raw arc length (rad) | blends kept "
-        "| shortcuts | direct | median post-processing (s) | median time to an executable "
-        "trajectory (s) |\n";
-  md << "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+        "| shortcuts | direct | waypoint | median post-processing (s) | median time to an "
+        "executable trajectory (s) |\n";
+  md << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const PlannerSpec& spec : specs) {
     if (!spec.available) continue;
     const PlannerStats& s = stats[spec.name];
@@ -332,8 +334,9 @@ void write_execution(std::ostream& md, std::map<std::string, PlannerStats>& stat
        << fixed(100 * (1 - d / raw), 0) << "% | " << fixed(median_of(s.stops), 1) << " | "
        << fixed(median_of(s.raw_stops), 1) << " | " << fixed(median_of(s.arc_length), 2) << " | "
        << fixed(median_of(s.cost), 2) << " | " << s.blends_kept << " / " << s.junctions << " | "
-       << s.shortcuts << " | " << s.direct << " | " << fixed(median_of(s.post_seconds), 4) << " | "
-       << fixed(median_of(s.ttfs_with_post), 4) << " |\n";
+       << s.shortcuts << " | " << s.direct << " | " << s.waypoint << " | "
+       << fixed(median_of(s.post_seconds), 4) << " | " << fixed(median_of(s.ttfs_with_post), 4)
+       << " |\n";
   }
 }
 
@@ -360,6 +363,7 @@ std::map<std::string, PlannerStats> planner_stats(const std::vector<RunRecord>& 
     s.blends_kept += std::max(0, r.blends_kept);
     s.shortcuts += std::max(0, r.shortcuts);
     s.direct += r.found_by == "direct";
+    s.waypoint += r.found_by == "waypoint";
   }
   return stats;
 }

@@ -143,12 +143,16 @@ RolloutStatus collision_status(const Simulator& sim, SimulatorWorkspace& ws, con
 }
 
 // One row of TrajectorySamples::ticks; its acceleration is filled in once known.
+// One resize and four copies: four range inserts cost 12 % of a one-rollout query (callgrind).
 void push_tick(std::vector<double>& ticks, const JointVector& q, const JointVector& dq,
                const JointVector& ddq, const JointVector& v_cmd) {
-  ticks.insert(ticks.end(), q.data(), q.data() + q.size());
-  ticks.insert(ticks.end(), dq.data(), dq.data() + dq.size());
-  ticks.insert(ticks.end(), ddq.data(), ddq.data() + ddq.size());
-  ticks.insert(ticks.end(), v_cmd.data(), v_cmd.data() + v_cmd.size());
+  const size_t n = static_cast<size_t>(q.size()), at = ticks.size();
+  ticks.resize(at + 4 * n);
+  double* row = ticks.data() + at;
+  std::copy_n(q.data(), n, row);
+  std::copy_n(dq.data(), n, row + n);
+  std::copy_n(ddq.data(), n, row + 2 * n);
+  std::copy_n(v_cmd.data(), n, row + 3 * n);
 }
 
 void push_sample(const TrajectorySamples& samples, const JointVector& q, const JointVector& dq) {
@@ -441,6 +445,12 @@ RolloutResult simulate(const Simulator& sim, SimulatorWorkspace& ws, const Joint
 
   const int max_ticks =
       static_cast<int>(std::ceil((profile.duration + sim.options.max_settle_time) / dt));
+  // The command's rows and half as many for the settle at once (a blended step of the lazysp
+  // shortcut test: 1,477 rows for 1,030 of its command), not a vector doubled ten times.
+  if (samples.ticks)
+    samples.ticks->reserve(samples.ticks->size() +
+                           4 * static_cast<size_t>(n) *
+                               static_cast<size_t>(1.5 * std::ceil(profile.duration / dt) + 2));
   CheckpointSaver saver(resume, first_tick);
   for (int tick = first_tick; tick < max_ticks; ++tick) {
     if (saver.due(tick)) saver.save(s, result, tick, end_effector.velocity(), samples);
