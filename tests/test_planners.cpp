@@ -783,18 +783,23 @@ struct BlockedScene {
   Simulator sim;  // refers to `collision`
 };
 
-// The fixture's scene with a ball of `radius` where the hand is at q.
-std::unique_ptr<BlockedScene> scene_with_ball(const Fixture& f, const JointVector& q,
-                                              double radius) {
+// A ball of `radius` where the hand is at q.
+Obstacle ball_at(const Fixture& f, const JointVector& q, double radius) {
   RobotData data(f.robot);
   forward_kinematics(f.robot, data, q);
-  Environment env = f.env;
   Obstacle ball;
   ball.name = "unseen";
   ball.shape.type = ShapeType::Sphere;
   ball.shape.radius = radius;
   ball.pose.p = link_pose(f.robot, data, f.robot.tip_link()).p;
-  env.obstacles.push_back(ball);
+  return ball;
+}
+
+// The fixture's scene with a ball of `radius` where the hand is at q.
+std::unique_ptr<BlockedScene> scene_with_ball(const Fixture& f, const JointVector& q,
+                                              double radius) {
+  Environment env = f.env;
+  env.obstacles.push_back(ball_at(f, q, radius));
   return std::make_unique<BlockedScene>(f, env);
 }
 
@@ -949,6 +954,19 @@ TEST(LazySp, AGoalInAPocketIsApproachedAlongAnEdgeLookedAtBackward) {
             << (without.success ? "solved" : "not solved") << ")\n";
 }
 
+// The problem a -> c (stop_at_first) and the fixture's scene with a ball in the middle of its
+// joint-space line, where the direct command would pass.
+struct BallOnTheLine {
+  PlanningProblem p;
+  std::unique_ptr<BlockedScene> scene;
+};
+
+BallOnTheLine ball_on_the_line(const Fixture& f) {
+  BallOnTheLine b{library_problem(f.a, f.c, 10), scene_with_ball(f, 0.5 * (f.a + f.c), 0.04)};
+  b.p.termination.stop_at_first = true;
+  return b;
+}
+
 // The shortcut of a candidate that looks free (parameter `shortcut`): a ball on the joint-space
 // line a -> c blocks the straight way, so the shortcut goes through a predicted state of the
 // candidate. Its straight parts are simulated as one command with the junction blended
@@ -956,10 +974,9 @@ TEST(LazySp, AGoalInAPocketIsApproachedAlongAnEdgeLookedAtBackward) {
 // simulation; without the shortcut, the candidate's edges are simulated, each with its settle.
 TEST(LazySp, ACandidateThatLooksFreeIsSimulatedAsItsShortcut) {
   const Fixture& f = fixture();
-  PlanningProblem p = library_problem(f.a, f.c, 10);
-  p.termination.stop_at_first = true;
-  const std::unique_ptr<BlockedScene> scene = scene_with_ball(f, 0.5 * (f.a + f.c), 0.04);
-  const Simulator& blocked = scene->sim;
+  const BallOnTheLine b = ball_on_the_line(f);
+  const PlanningProblem& p = b.p;
+  const Simulator& blocked = b.scene->sim;
   SimulatorWorkspace ws(blocked);
   ASSERT_EQ(check_state(blocked, ws, p.start), RolloutStatus::Valid);
   ASSERT_EQ(check_state(blocked, ws, p.goal.q), RolloutStatus::Valid);
@@ -999,10 +1016,9 @@ TEST(LazySp, ACandidateThatLooksFreeIsSimulatedAsItsShortcut) {
 // Without waypoints the search answers.
 TEST(LazySp, ABlockedDirectCommandIsTriedThroughAWaypointBeforeAnySearch) {
   const Fixture& f = fixture();
-  PlanningProblem p = library_problem(f.a, f.c, 10);
-  p.termination.stop_at_first = true;
-  const std::unique_ptr<BlockedScene> scene = scene_with_ball(f, 0.5 * (f.a + f.c), 0.04);
-  const Simulator& blocked = scene->sim;
+  const BallOnTheLine b = ball_on_the_line(f);
+  const PlanningProblem& p = b.p;
+  const Simulator& blocked = b.scene->sim;
   SimulatorWorkspace ws(blocked);
   ASSERT_FALSE(line_looks_free(blocked, ws, p.start, p.goal.q)) << "the ball misses the line";
   const PlanningContext context = session_context(f, blocked);
@@ -1042,6 +1058,38 @@ TEST(LazySp, ABlockedDirectCommandIsTriedThroughAWaypointBeforeAnySearch) {
   std::cout << "[ lazysp  ] waypoint: " << r.counters.simulations << " simulations, "
             << r.counters.collision_checks << " checks; without waypoints "
             << without.counters.simulations << " simulations (" << without.found_by << ")\n";
+}
+
+// Where no single waypoint passes, two are tried: the scene of the test above, and a ball more on
+// each answer through one waypoint (at the hand, halfway), until lazysp answers through two
+// (found_by "two_waypoints": one blended step, re-validated), still with no lazy search.
+TEST(LazySp, WhereNoSingleWaypointPassesTwoAreTried) {
+  const Fixture& f = fixture();
+  PlanningProblem p = library_problem(f.a, f.c, 10);
+  p.termination.stop_at_first = true;
+  Environment env = f.env;
+  env.obstacles.push_back(ball_at(f, 0.5 * (f.a + f.c), 0.04));
+  for (int balls = 1; balls <= 8; ++balls) {
+    const BlockedScene scene(f, env);
+    SimulatorWorkspace ws(scene.sim);
+    const PlanResult r = plan(session_context(f, scene.sim), ws, "lazysp", {}, p);
+    ASSERT_TRUE(r.success) << r.failure;
+    if (r.found_by == "two_waypoints") {
+      EXPECT_EQ(r.counters.lazy_edges, 0u);
+      ASSERT_EQ(r.best_path.size(), 1u);
+      EXPECT_EQ(r.best_path[0].bundle_edge, -1);
+      EXPECT_GE(r.best_path[0].knot_times.size(), 4u) << "not a command through two waypoints";
+      expect_revalidated(f, scene.sim, p, r);
+      std::cout << "[ lazysp  ] two waypoints after " << balls
+                << " balls: " << r.counters.simulations << " simulations\n";
+      return;
+    }
+    ASSERT_EQ(r.found_by, "waypoint") << "with " << balls << " balls, found by " << r.found_by
+                                      << " before two waypoints were needed";
+    const Trajectory t = realize_path(scene.sim, ws, p.start, r.best_path, p.goal, kSampleEvery);
+    env.obstacles.push_back(ball_at(f, t.q[t.q.size() / 2], 0.04));
+  }
+  FAIL() << "eight balls and still one waypoint";
 }
 
 // When the look rejects a candidate, the round's search goes on without the rejected edge and

@@ -234,7 +234,7 @@ struct PlannerStats {
       ttfs_with_post;
   long junctions = 0, blends_kept = 0, shortcuts = 0;
   size_t direct = 0;    // solved by the straight command tried before the search
-  size_t waypoint = 0;  // by lazysp's straight commands through one waypoint, tried next
+  size_t waypoint = 0;  // by lazysp's straight commands through one or two waypoints, tried next
 };
 
 std::string fixed(double value, int digits) {
@@ -320,7 +320,7 @@ void write_execution(std::ostream& md, std::map<std::string, PlannerStats>& stat
         "executable trajectory: time to first solution plus post-processing. Direct: runs a "
         "bundle planner answered with the straight command it tries before searching (none "
         "with --no-direct); waypoint: runs lazysp answered with the straight commands through "
-        "one sampled waypoint it tries next (none with --no-direct).\n\n";
+        "one or two sampled waypoints it tries next (none with --no-direct).\n\n";
   md << "| planner | median duration (s) | median raw duration (s) | shorter | median stops | "
         "median raw stops | median arc length (rad) | median raw arc length (rad) | blends kept "
         "| shortcuts | direct | waypoint | median post-processing (s) | median time to an "
@@ -363,7 +363,7 @@ std::map<std::string, PlannerStats> planner_stats(const std::vector<RunRecord>& 
     s.blends_kept += std::max(0, r.blends_kept);
     s.shortcuts += std::max(0, r.shortcuts);
     s.direct += r.found_by == "direct";
-    s.waypoint += r.found_by == "waypoint";
+    s.waypoint += r.found_by == "waypoint" || r.found_by == "two_waypoints";
   }
   return stats;
 }

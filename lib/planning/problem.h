@@ -152,13 +152,12 @@ struct PlanResult {
   PlannerCounters counters;
   std::string failure;  // why there is no solution
   // Which part of the planner found the best path, for planners with several: "direct" (the
-  // bundle planners' straight command, tried first), "waypoint" (lazysp's straight commands
-  // through one sampled waypoint, tried next), "bundle", "growth", "connection",
-  // "approach" or "shortcut" (lazysp's search, growth, direct command into the goal from a near
-  // state, the way in through an approach where that collided, or a candidate's shortcut);
-  // "start" for
-  // any planner when the start already lay in the goal region (the path of no motion); else
-  // empty.
+  // bundle planners' straight command, tried first), "waypoint" and "two_waypoints" (lazysp's
+  // straight commands through one or two sampled waypoints, tried next), "bundle", "growth",
+  // "connection", "approach" or "shortcut" (lazysp's search, growth, direct command into the
+  // goal from a near state, the way in through an approach where that collided, or a
+  // candidate's shortcut); "start" for any planner when the start already lay in the goal
+  // region (the path of no motion); else empty.
   std::string found_by;
 };
 

@@ -374,8 +374,8 @@ void bind_result(py::module_& m) {
                        : py::str(r.result().found_by);
           },
           "Which part of the planner found the best path (direct: the straight command the "
-          "bundle planners try first; lazysp: waypoint, bundle, growth, connection, approach or "
-          "shortcut), or None.")
+          "bundle planners try first; lazysp: waypoint, two_waypoints, bundle, growth, "
+          "connection, approach or shortcut), or None.")
       .def_property_readonly(
           "duration",
           [opt](const PyResult& r) { return opt(r.result().success, r.trajectory().duration); },
