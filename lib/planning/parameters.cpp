@@ -69,6 +69,14 @@ ParameterSpec real_parameter(const std::string& name, double default_value, doub
   return p;
 }
 
+ParameterSpec integer_parameter(const std::string& name, double default_value, double lower,
+                                double upper, const std::string& description) {
+  ParameterSpec p = real_parameter(name, default_value, lower, false, description);
+  p.type = ParameterType::Integer;
+  p.upper = upper;
+  return p;
+}
+
 ParameterSpec boolean_parameter(const std::string& name, bool default_value,
                                 const std::string& description) {
   ParameterSpec p;

@@ -42,6 +42,10 @@ struct ParameterSpec {
 ParameterSpec real_parameter(const std::string& name, double default_value, double lower,
                              bool lower_exclusive, const std::string& description);
 
+// An integer parameter with a fixed default and inclusive bounds.
+ParameterSpec integer_parameter(const std::string& name, double default_value, double lower,
+                                double upper, const std::string& description);
+
 // A boolean parameter (1 true, 0 false).
 ParameterSpec boolean_parameter(const std::string& name, bool default_value,
                                 const std::string& description);

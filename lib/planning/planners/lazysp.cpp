@@ -1133,31 +1133,25 @@ PlannerInfo lazysp_planner_info() {
       "then simulates only the candidate path (first as its shortcut); grows along bundle edges "
       "that look free, else by random commands; anytime";
   info.needs.bundle = true;
-  ParameterSpec limit = real_parameter(
-      "expansion_limit", 20000, 1, false,
+  const ParameterSpec limit = integer_parameter(
+      "expansion_limit", 20000, 1, 1e9,
       "predicted states expanded per round of the lazy search before it gives the growth a turn");
-  limit.type = ParameterType::Integer;
-  limit.upper = 1e9;
   // 50 since 2026-12-04 (sixth session): a rejection leaves out one edge from one state, and
   // starting the search again for it cost as many expansions as the first candidate had. On
   // the tuning sets, predicted states -12 to -62 %, simulations per plan the same or fewer but
   // in shelf.json; 3 and 10 kept more states (docs/performance.md).
-  ParameterSpec again = real_parameter(
-      "look_again", 50, 0, false,
+  const ParameterSpec again = integer_parameter(
+      "look_again", 50, 0, 1e6,
       "candidates a round's lazy search goes on to when the look rejects one (without that edge "
       "from that state, and what was planned through it), before the round ends (0: a round "
       "per candidate)");
-  again.type = ParameterType::Integer;
-  again.upper = 1e6;
-  ParameterSpec waypoints = real_parameter(
-      "waypoints", 128, 0, false,
+  const ParameterSpec waypoints = integer_parameter(
+      "waypoints", 128, 0, 1e6,
       "with direct, precheck and a joint goal: where the direct command fails, waypoints sampled "
       "around the start-goal midpoint, shortest way first; one whose state and lines from the "
       "start and into the goal look free is simulated as one blended command (found_by "
       "\"waypoint\"; at most 4 of them, each corrected up to 3 times to land in the goal), then "
       "pairs of them (\"two_waypoints\"), before the search (0: none)");
-  waypoints.type = ParameterType::Integer;
-  waypoints.upper = 1e6;
   info.parameters = {
       theta_parameter(),
       direct_parameter(),
