@@ -967,9 +967,23 @@ BallOnTheLine ball_on_the_line(const Fixture& f) {
   return b;
 }
 
-// The shortcut of a candidate that looks free (parameter `shortcut`): a ball on the joint-space
-// line a -> c blocks the straight way, so the shortcut goes through a predicted state of the
-// candidate. Its straight parts are simulated as one command with the junction blended
+// A path of one blended step: re-validated, and kept as it is by the post-processing (no
+// simulation); its executable trajectory.
+ExecutableTrajectory expect_kept_as_is(const Fixture& f, const PlanningContext& context,
+                                       SimulatorWorkspace& ws, const PlanningProblem& p,
+                                       const PlanResult& r) {
+  expect_revalidated(f, context.sim, p, r);
+  ExecutionOptions options;
+  options.limits = context.command;
+  const ExecutableTrajectory e =
+      make_executable(context.sim, ws, p.start, r.best_path, p.goal, options, kSampleEvery);
+  EXPECT_EQ(e.stats.simulations, 0);
+  return e;
+}
+
+// The shortcut of a candidate that looks free (parameter `candidate_shortcut`): a ball on the
+// joint-space line a -> c blocks the straight way, so the shortcut goes through a predicted state
+// of the candidate. Its straight parts are simulated as one command with the junction blended
 // (found_by "shortcut", one step with knot times), which the post-processing keeps without a
 // simulation; without the shortcut, the candidate's edges are simulated, each with its settle.
 TEST(LazySp, ACandidateThatLooksFreeIsSimulatedAsItsShortcut) {
@@ -991,13 +1005,7 @@ TEST(LazySp, ACandidateThatLooksFreeIsSimulatedAsItsShortcut) {
   EXPECT_EQ(step.bundle_edge, -1);
   EXPECT_FALSE(step.knot_times.empty()) << "not the blended command";
   EXPECT_FALSE(step.outcome_rows.empty());
-  expect_revalidated(f, blocked, p, r);
-  ExecutionOptions options;
-  options.limits = context.command;
-  const ExecutableTrajectory e =
-      make_executable(blocked, ws, p.start, r.best_path, p.goal, options, kSampleEvery);
-  EXPECT_EQ(e.stats.simulations, 0);
-  EXPECT_EQ(e.stats.stops, 0);
+  EXPECT_EQ(expect_kept_as_is(f, context, ws, p, r).stats.stops, 0);
 
   const PlanResult edges = plan(context, ws, "lazysp", searching("lazysp"), p);
   ASSERT_TRUE(edges.success) << edges.failure;
@@ -1032,12 +1040,7 @@ TEST(LazySp, ABlockedDirectCommandIsTriedThroughAWaypointBeforeAnySearch) {
   EXPECT_EQ(step.bundle_edge, -1);
   ASSERT_EQ(step.knot_times.size() * f.sim.robot.dof, step.knots.size());
   EXPECT_GE(step.knot_times.size(), 3u) << "not a command through a waypoint";
-  expect_revalidated(f, blocked, p, r);
-  ExecutionOptions options;
-  options.limits = context.command;
-  const ExecutableTrajectory e =
-      make_executable(blocked, ws, p.start, r.best_path, p.goal, options, kSampleEvery);
-  EXPECT_EQ(e.stats.simulations, 0);
+  expect_kept_as_is(f, context, ws, p, r);
 
   const PlanResult again = plan(context, ws, "lazysp", {}, p);
   ASSERT_TRUE(again.success && again.best_path.size() == 1u) << again.failure;
@@ -1079,7 +1082,7 @@ TEST(LazySp, WhereNoSingleWaypointPassesTwoAreTried) {
       ASSERT_EQ(r.best_path.size(), 1u);
       EXPECT_EQ(r.best_path[0].bundle_edge, -1);
       EXPECT_GE(r.best_path[0].knot_times.size(), 4u) << "not a command through two waypoints";
-      expect_revalidated(f, scene.sim, p, r);
+      expect_kept_as_is(f, session_context(f, scene.sim), ws, p, r);
       std::cout << "[ lazysp  ] two waypoints after " << balls
                 << " balls: " << r.counters.simulations << " simulations\n";
       return;

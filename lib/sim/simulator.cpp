@@ -142,9 +142,9 @@ RolloutStatus collision_status(const Simulator& sim, SimulatorWorkspace& ws, con
   return report.env_collision ? RolloutStatus::EnvCollision : RolloutStatus::SelfCollision;
 }
 
-// One row of TrajectorySamples::ticks; its acceleration is filled in once known.
-// One resize and four copies rather than four range inserts: 1.6 % fewer instructions in a
-// one-rollout query (callgrind, docs/performance.md).
+// One row of TrajectorySamples::ticks; its acceleration is filled in once known. One resize and
+// four copies rather than four range inserts: 1.6 % fewer instructions in a one-rollout query
+// (callgrind, docs/performance.md).
 void push_tick(std::vector<double>& ticks, const JointVector& q, const JointVector& dq,
                const JointVector& ddq, const JointVector& v_cmd) {
   const size_t n = static_cast<size_t>(q.size()), at = ticks.size();
